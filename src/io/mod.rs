@@ -1,0 +1,54 @@
+//! Run output: HDF5 frames with their XDMF index, the per-step `stats.csv`, and the output
+//! directory itself (never overwritten by accident).
+
+pub mod frames;
+pub mod stats;
+pub mod xdmf;
+
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("output directory {dir} cannot be used: {source}")]
+    Directory {
+        dir: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("output directory {dir} already holds a run ({file}); pass --overwrite to replace it, or choose another --out")]
+    HoldsRun { dir: PathBuf, file: String },
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot write {path}: {source}")]
+    Hdf5 { path: PathBuf, source: hdf5::Error },
+}
+
+/// Files that make a directory an isph run.
+pub const RUN_FILES: [&str; 3] = [frames::FILE_NAME, xdmf::FILE_NAME, stats::FILE_NAME];
+
+/// Creates `dir` if needed and checks it can hold a new run: it must be writable, and must
+/// not already hold one unless `overwrite` (then the old run's files are removed).
+pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError> {
+    let dir_error = |source| OutputError::Directory {
+        dir: dir.to_owned(),
+        source,
+    };
+    std::fs::create_dir_all(dir).map_err(dir_error)?;
+    for file in RUN_FILES {
+        if dir.join(file).exists() {
+            if !overwrite {
+                return Err(OutputError::HoldsRun {
+                    dir: dir.to_owned(),
+                    file: file.to_owned(),
+                });
+            }
+            std::fs::remove_file(dir.join(file)).map_err(dir_error)?;
+        }
+    }
+    // Probe that files can be created here before any simulation work starts.
+    let probe = dir.join(".isph-write-test");
+    std::fs::write(&probe, b"").map_err(dir_error)?;
+    std::fs::remove_file(&probe).map_err(dir_error)
+}

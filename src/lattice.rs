@@ -1,0 +1,91 @@
+//! Initial particles on a lattice of spacing dx anchored at the container's lower corner:
+//! fluid blocks, the container's dummy wall layers and solid obstacles.
+
+use crate::kernel::SUPPORT_IN_H;
+use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
+use crate::scene::Scene;
+
+/// Number of dummy wall layers that fill the kernel support 3h.
+pub fn wall_layers(scene: &Scene) -> usize {
+    (SUPPORT_IN_H * scene.solver.h_over_dx - 1e-9).ceil() as usize
+}
+
+/// Particles of the scene at t = 0: fluid first (in block order), then walls.
+pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
+    let dx = scene.spacing;
+    let volume = dx.powi(D as i32);
+    let layers = wall_layers(scene) as i64;
+    let lo = &scene.container.min;
+    // Lattice point k (per axis) sits at lo + (k + ½) dx.
+    let cells: [i64; D] =
+        std::array::from_fn(|d| ((scene.container.max[d] - lo[d]) / dx).round() as i64);
+    let point =
+        |k: [i64; D]| -> [f64; D] { std::array::from_fn(|d| lo[d] + (k[d] as f64 + 0.5) * dx) };
+    let in_obstacle = |x: &[f64; D]| scene.obstacles.iter().any(|o| o.contains(x));
+
+    let mut particles = Particles::<D>::default();
+    // A lattice point belongs to the first block that contains it.
+    for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
+        let x = point(k);
+        let block = scene.blocks.iter().find(|b| b.region.contains(&x));
+        if let (Some(b), false) = (block, in_obstacle(&x)) {
+            let fluid = &scene.fluids[b.fluid];
+            particles.push(NewParticle {
+                pos: x,
+                kind: Kind::Fluid,
+                fluid: b.fluid as u16,
+                mass: fluid.density * volume,
+                rest_density: fluid.density,
+                viscosity: fluid.viscosity,
+            });
+        }
+    });
+    let wall_density = scene.fluids[0].density;
+    let wall = |x: [f64; D]| NewParticle {
+        pos: x,
+        kind: Kind::Wall,
+        fluid: NO_FLUID,
+        mass: wall_density * volume,
+        rest_density: wall_density,
+        viscosity: 0.0,
+    };
+    // Container walls: every lattice point within `layers` of the box, outside it.
+    let outer_lo = std::array::from_fn(|_| -layers);
+    let outer_hi = std::array::from_fn(|d| cells[d] + layers);
+    for_each_lattice_point(outer_lo, outer_hi, |k| {
+        if (0..D).any(|d| k[d] < 0 || k[d] >= cells[d]) {
+            particles.push(wall(point(k)));
+        }
+    });
+    // Obstacles: solid boxes of wall particles.
+    for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
+        let x = point(k);
+        if in_obstacle(&x) {
+            particles.push(wall(x));
+        }
+    });
+    particles
+}
+
+/// Calls `f` for every integer point k with lo ≤ k < hi, x fastest.
+fn for_each_lattice_point<const D: usize>(lo: [i64; D], hi: [i64; D], mut f: impl FnMut([i64; D])) {
+    if (0..D).any(|d| hi[d] <= lo[d]) {
+        return;
+    }
+    let mut k = lo;
+    loop {
+        f(k);
+        let mut d = 0;
+        loop {
+            k[d] += 1;
+            if k[d] < hi[d] {
+                break;
+            }
+            k[d] = lo[d];
+            d += 1;
+            if d == D {
+                return;
+            }
+        }
+    }
+}

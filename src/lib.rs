@@ -1,0 +1,19 @@
+//! isph: a stabilised incompressible SPH solver (Hassaballah, Aly & Abdelnaim 2020).
+//!
+//! A scene file becomes a [`scene::Scene`], whose particles ([`lattice`]) advance by the
+//! projection step of [`simulation::Simulation`]; [`run`] drives a whole run with its output.
+
+pub mod grid;
+pub mod io;
+pub mod kernel;
+pub mod lattice;
+pub mod linsolve;
+pub mod particles;
+pub mod plan;
+pub mod ppe;
+pub mod progress;
+pub mod reduce;
+pub mod run;
+pub mod scene;
+pub mod simulation;
+pub mod sph;

@@ -1,0 +1,142 @@
+//! Particle storage: structure of arrays, one `Vec` per component, permuted together
+//! whenever the particles are re-sorted by cell. `id` is stable across sorts.
+
+/// What a particle is (the `kind` column of the output).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Kind {
+    Fluid = 0,
+    /// Fixed dummy wall particle (container walls and obstacles).
+    Wall = 1,
+}
+
+/// `fluid` index stored for particles that belong to no fluid (walls).
+pub const NO_FLUID: u16 = u16::MAX;
+
+#[derive(Clone, Debug)]
+pub struct Particles<const D: usize> {
+    pub pos: [Vec<f64>; D],
+    pub vel: [Vec<f64>; D],
+    pub pressure: Vec<f64>,
+    /// Summation density ρ_i = Σ_j m_j W_ij (fluid); the rest density for walls.
+    pub density: Vec<f64>,
+    pub mass: Vec<f64>,
+    /// ρ0 of the particle's fluid (walls: the reference density of the first fluid).
+    pub rest_density: Vec<f64>,
+    /// Kinematic viscosity ν of the particle's fluid (walls: 0, they take the fluid's ν).
+    pub viscosity: Vec<f64>,
+    pub kind: Vec<Kind>,
+    pub fluid: Vec<u16>,
+    pub id: Vec<u64>,
+}
+
+/// Everything needed to create one particle.
+#[derive(Clone, Copy, Debug)]
+pub struct NewParticle<const D: usize> {
+    pub pos: [f64; D],
+    pub kind: Kind,
+    pub fluid: u16,
+    pub mass: f64,
+    pub rest_density: f64,
+    pub viscosity: f64,
+}
+
+/// D empty component vectors.
+pub fn components<const D: usize>() -> [Vec<f64>; D] {
+    std::array::from_fn(|_| Vec::new())
+}
+
+impl<const D: usize> Default for Particles<D> {
+    fn default() -> Self {
+        Self {
+            pos: components(),
+            vel: components(),
+            pressure: Vec::new(),
+            density: Vec::new(),
+            mass: Vec::new(),
+            rest_density: Vec::new(),
+            viscosity: Vec::new(),
+            kind: Vec::new(),
+            fluid: Vec::new(),
+            id: Vec::new(),
+        }
+    }
+}
+
+impl<const D: usize> Particles<D> {
+    pub fn len(&self) -> usize {
+        self.id.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.id.is_empty()
+    }
+
+    /// Appends a particle at rest with zero pressure; its id is its creation index.
+    pub fn push(&mut self, p: NewParticle<D>) {
+        for d in 0..D {
+            self.pos[d].push(p.pos[d]);
+            self.vel[d].push(0.0);
+        }
+        self.id.push(self.id.len() as u64);
+        self.pressure.push(0.0);
+        self.density.push(p.rest_density);
+        self.mass.push(p.mass);
+        self.rest_density.push(p.rest_density);
+        self.viscosity.push(p.viscosity);
+        self.kind.push(p.kind);
+        self.fluid.push(p.fluid);
+    }
+
+    #[inline]
+    pub fn position(&self, i: usize) -> [f64; D] {
+        std::array::from_fn(|d| self.pos[d][i])
+    }
+
+    #[inline]
+    pub fn velocity(&self, i: usize) -> [f64; D] {
+        std::array::from_fn(|d| self.vel[d][i])
+    }
+
+    #[inline]
+    pub fn is_fluid(&self, i: usize) -> bool {
+        self.kind[i] == Kind::Fluid
+    }
+
+    pub fn fluid_count(&self) -> usize {
+        self.kind.iter().filter(|&&k| k == Kind::Fluid).count()
+    }
+
+    /// Reorders every array so that new index k holds old particle `order[k]`.
+    pub fn permute(&mut self, order: &[u32], scratch: &mut Vec<f64>) {
+        let f64_arrays = self.pos.iter_mut().chain(self.vel.iter_mut()).chain([
+            &mut self.pressure,
+            &mut self.density,
+            &mut self.mass,
+            &mut self.rest_density,
+            &mut self.viscosity,
+        ]);
+        for a in f64_arrays {
+            permute_with(a, order, scratch);
+        }
+        self.kind = order.iter().map(|&o| self.kind[o as usize]).collect();
+        self.fluid = order.iter().map(|&o| self.fluid[o as usize]).collect();
+        self.id = order.iter().map(|&o| self.id[o as usize]).collect();
+    }
+
+    /// Index of each id: `index_of_id[id] = i` (for writing frames in id order).
+    pub fn index_by_id(&self) -> Vec<u32> {
+        let mut by_id = vec![0u32; self.len()];
+        for (i, &id) in self.id.iter().enumerate() {
+            by_id[id as usize] = i as u32;
+        }
+        by_id
+    }
+}
+
+/// a ← a[order], through a reusable scratch buffer.
+fn permute_with(a: &mut Vec<f64>, order: &[u32], scratch: &mut Vec<f64>) {
+    scratch.clear();
+    scratch.extend(order.iter().map(|&o| a[o as usize]));
+    std::mem::swap(a, scratch);
+}

@@ -1,0 +1,122 @@
+//! What a scene will run: the stages of a step in order, the particle counts, and the memory
+//! the arrays of those stages take.
+
+use crate::lattice;
+use crate::linsolve::BiCgStab;
+use crate::particles::Kind;
+use crate::scene::Scene;
+use std::fmt;
+
+/// One stage of the time step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    pub name: &'static str,
+    pub what: &'static str,
+    /// Per-particle bytes of the arrays this stage owns.
+    pub bytes_per_particle: usize,
+}
+
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub scene: String,
+    pub dimensions: usize,
+    pub fluid_particles: usize,
+    pub wall_particles: usize,
+    pub smoothing_length: f64,
+    pub wall_layers: usize,
+    pub stages: Vec<Stage>,
+}
+
+impl Plan {
+    pub fn new(scene: &Scene) -> Plan {
+        let kinds = match scene.dimensions {
+            2 => lattice::build::<2>(scene).kind,
+            _ => lattice::build::<3>(scene).kind,
+        };
+        let fluid = kinds.iter().filter(|&&k| k == Kind::Fluid).count();
+        let d = scene.dimensions;
+        let f64s = |n: usize| 8 * n;
+        let stages = vec![
+            Stage {
+                name: "particles",
+                what: "SoA state: position, velocity, pressure, density, mass, ρ0, ν, kind, fluid, id",
+                bytes_per_particle: f64s(2 * d + 5) + 1 + 2 + 8,
+            },
+            Stage {
+                name: "cell list",
+                what: "counting sort by cell (x fastest), all arrays permuted together",
+                bytes_per_particle: 4 + 4 + 8,
+            },
+            Stage {
+                name: "density + free surface",
+                what: "summation density, ∇·r < threshold ⇒ free surface (P = 0)",
+                bytes_per_particle: f64s(2) + 2,
+            },
+            Stage {
+                name: "predictor",
+                what: "Eq. (5): u* = u + Δt (ν∇²u (Eq. 26) + g)",
+                bytes_per_particle: f64s(d),
+            },
+            Stage {
+                name: "pressure Poisson equation",
+                what: "Eq. (6) source, Eq. (27) Laplacian matrix-free in BiCGSTAB + Jacobi, warm start; walls: Neumann extrapolation",
+                bytes_per_particle: f64s(2) + BiCgStab::BYTES_PER_UNKNOWN,
+            },
+            Stage { name: "corrector", what: "Eq. (7) with the pressure gradient of Eq. (23)", bytes_per_particle: 0 },
+            Stage { name: "advection", what: "Eq. (8): r += Δt u", bytes_per_particle: 0 },
+            Stage {
+                name: "diagnostics",
+                what: "max speed, kinetic energy, density error, penetrations → stats.csv",
+                bytes_per_particle: 0,
+            },
+        ];
+        Plan {
+            scene: scene.name.clone(),
+            dimensions: d,
+            fluid_particles: fluid,
+            wall_particles: kinds.len() - fluid,
+            smoothing_length: scene.smoothing_length(),
+            wall_layers: lattice::wall_layers(scene),
+            stages,
+        }
+    }
+
+    pub fn particles(&self) -> usize {
+        self.fluid_particles + self.wall_particles
+    }
+
+    pub fn bytes_per_particle(&self) -> usize {
+        self.stages.iter().map(|s| s.bytes_per_particle).sum()
+    }
+}
+
+impl fmt::Display for Plan {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        let n = self.particles();
+        writeln!(f, "scene {} ({}D)", self.scene, self.dimensions)?;
+        writeln!(
+            f,
+            "particles: {} fluid + {} wall = {n}   (h = {:.4e} m, {} wall layers)",
+            self.fluid_particles, self.wall_particles, self.smoothing_length, self.wall_layers
+        )?;
+        writeln!(f, "stages per step:")?;
+        for (k, s) in self.stages.iter().enumerate() {
+            let mib = (s.bytes_per_particle * n) as f64 / (1 << 20) as f64;
+            writeln!(
+                f,
+                "  {}. {:<26} {:>4} B/particle {:>9.2} MiB  {}",
+                k + 1,
+                s.name,
+                s.bytes_per_particle,
+                mib,
+                s.what
+            )?;
+        }
+        let total = self.bytes_per_particle();
+        write!(
+            f,
+            "memory: {total} B/particle, {:.2} MiB for the particle arrays (plus the cell grid)",
+            (total * n) as f64 / (1 << 20) as f64
+        )
+    }
+}

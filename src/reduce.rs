@@ -1,0 +1,68 @@
+//! Data-parallel helpers whose results do not depend on the number of threads.
+//!
+//! Every per-particle loop writes only its own particle's result, and every sum is taken over
+//! fixed chunks whose partial sums are added in chunk order: the same bits for any thread count.
+
+use rayon::prelude::*;
+
+/// Chunk length of the fixed-order reductions and of the per-particle blocks.
+pub const CHUNK: usize = 2048;
+
+/// Σ_i f(i) for i in 0..n, summed in fixed chunks (deterministic for any thread count).
+pub fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
+    let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).sum::<f64>())
+        .collect();
+    partial.iter().sum()
+}
+
+/// max_i f(i) for i in 0..n (0 when n = 0). A maximum does not depend on the order.
+pub fn max(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
+    (0..n)
+        .into_par_iter()
+        .map(|i| f(i))
+        .reduce(|| 0.0, f64::max)
+}
+
+/// Number of i in 0..n with `pred(i)`.
+pub fn count(n: usize, pred: impl Fn(usize) -> bool + Sync) -> usize {
+    (0..n).into_par_iter().filter(|&i| pred(i)).count()
+}
+
+/// out[i] = f(i) for every i, in parallel.
+pub fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync) {
+    out.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(c, block)| {
+            for (k, o) in block.iter_mut().enumerate() {
+                *o = f(c * CHUNK + k);
+            }
+        });
+}
+
+/// out[d][i] = f(i)[d] for every i: a per-particle vector result written into SoA components.
+pub fn fill_vector<const D: usize>(out: &mut [Vec<f64>; D], f: impl Fn(usize) -> [f64; D] + Sync) {
+    let n = out[0].len();
+    let mut chunks = out.each_mut().map(|v| v.chunks_mut(CHUNK));
+    let blocks: Vec<[&mut [f64]; D]> = (0..n.div_ceil(CHUNK))
+        .map(|_| {
+            chunks
+                .each_mut()
+                .map(|c| c.next().expect("components have equal length"))
+        })
+        .collect();
+    blocks.into_par_iter().enumerate().for_each(|(c, block)| {
+        for k in 0..block[0].len() {
+            let v = f(c * CHUNK + k);
+            for d in 0..D {
+                block[d][k] = v[d];
+            }
+        }
+    });
+}
+
+/// Σ_i a[i] b[i] in fixed chunks.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    sum(a.len(), |i| a[i] * b[i])
+}

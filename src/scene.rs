@@ -1,0 +1,430 @@
+//! Scene files: TOML in SI units, parsed with unknown keys rejected, then validated into a
+//! `Scene`. Every error names the file, the key and, where it can be found, the line.
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Syntax { path: PathBuf, message: String },
+    #[error("{path}{}: `{key}` {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Invalid {
+        path: PathBuf,
+        line: Option<usize>,
+        key: String,
+        message: String,
+    },
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    simulation: SimulationSection,
+    #[serde(default)]
+    fluid: Vec<Fluid>,
+    #[serde(default)]
+    fluid_block: Vec<FluidBlock>,
+    container: BoxSection,
+    #[serde(default)]
+    obstacle: Vec<BoxSection>,
+    #[serde(default)]
+    solver: SolverSettings,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SimulationSection {
+    name: Option<String>,
+    dimensions: i64,
+    spacing: f64,
+    end_time: f64,
+    output_interval: f64,
+    gravity: Vec<f64>,
+}
+
+/// One fluid of the scene.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fluid {
+    pub name: String,
+    /// Rest density ρ0 [kg/m³].
+    pub density: f64,
+    /// Kinematic viscosity ν [m²/s].
+    pub viscosity: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FluidBlock {
+    fluid: String,
+    min: Vec<f64>,
+    max: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BoxSection {
+    min: Vec<f64>,
+    max: Vec<f64>,
+}
+
+/// The `[solver]` section: pressure solve, relaxation and time step.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSettings {
+    /// Relative residual ‖b − Ax‖/‖b‖ at which BiCGSTAB stops.
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    /// Relaxation α of the density-invariance term of the PPE source, Eq. (6).
+    pub alpha: f64,
+    /// Courant number C of Δt ≤ C h / |u|max.
+    pub cfl: f64,
+    /// Smoothing length over particle spacing, h/dx.
+    pub h_over_dx: f64,
+    /// Free-surface threshold on ∇·r (default 1.5 in 2D, 2.4 in 3D).
+    pub free_surface_threshold: Option<f64>,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            tolerance: 1.0e-6,
+            max_iterations: 1000,
+            alpha: 0.01,
+            cfl: 0.2,
+            h_over_dx: 1.2,
+            free_surface_threshold: None,
+        }
+    }
+}
+
+/// An axis-aligned box [min, max].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Aabb {
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+}
+
+impl Aabb {
+    /// True when x lies strictly inside the box.
+    pub fn contains(&self, x: &[f64]) -> bool {
+        x.iter()
+            .zip(&self.min)
+            .zip(&self.max)
+            .all(|((x, lo), hi)| x > lo && x < hi)
+    }
+
+    fn within(&self, outer: &Aabb) -> bool {
+        (0..self.min.len()).all(|d| self.min[d] >= outer.min[d] && self.max[d] <= outer.max[d])
+    }
+}
+
+/// A block of fluid `fluid` (index into `Scene::fluids`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Block {
+    pub fluid: usize,
+    pub region: Aabb,
+}
+
+/// A validated scene.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub path: PathBuf,
+    pub name: String,
+    pub dimensions: usize,
+    pub spacing: f64,
+    pub end_time: f64,
+    pub output_interval: f64,
+    pub gravity: Vec<f64>,
+    pub fluids: Vec<Fluid>,
+    pub blocks: Vec<Block>,
+    pub container: Aabb,
+    pub obstacles: Vec<Aabb>,
+    pub solver: SolverSettings,
+}
+
+impl Scene {
+    /// Reads, parses and validates a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        Scene::parse(&text, path)
+    }
+
+    /// Parses and validates scene text; `path` is used in messages and for the default name.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        let file: SceneFile = toml::from_str(text).map_err(|e| SceneError::Syntax {
+            path: path.to_owned(),
+            message: e.to_string().trim_end().to_owned(),
+        })?;
+        Validator { text, path }.scene(file)
+    }
+
+    /// Free-surface threshold on ∇·r in effect.
+    pub fn free_surface_threshold(&self) -> f64 {
+        self.solver
+            .free_surface_threshold
+            .unwrap_or(if self.dimensions == 2 { 1.5 } else { 2.4 })
+    }
+
+    /// Smoothing length h.
+    pub fn smoothing_length(&self) -> f64 {
+        self.solver.h_over_dx * self.spacing
+    }
+}
+
+/// Checks a parsed file and turns it into a `Scene`, locating bad keys in the source text.
+struct Validator<'a> {
+    text: &'a str,
+    path: &'a Path,
+}
+
+impl Validator<'_> {
+    fn error(&self, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            path: self.path.to_owned(),
+            line: line_of_key(self.text, key),
+            key: key.to_owned(),
+            message: message.into(),
+        }
+    }
+
+    fn check(&self, ok: bool, key: &str, message: impl Into<String>) -> Result<(), SceneError> {
+        if ok {
+            Ok(())
+        } else {
+            Err(self.error(key, message))
+        }
+    }
+
+    fn positive(&self, value: f64, key: &str, unit: &str) -> Result<(), SceneError> {
+        self.check(
+            value.is_finite() && value > 0.0,
+            key,
+            format!("= {value} must be a positive number [{unit}]"),
+        )
+    }
+
+    fn vector(&self, v: &[f64], dims: usize, key: &str) -> Result<(), SceneError> {
+        self.check(
+            v.len() == dims,
+            key,
+            format!(
+                "has {} components but the scene has `simulation.dimensions = {dims}`",
+                v.len()
+            ),
+        )?;
+        self.check(
+            v.iter().all(|x| x.is_finite()),
+            key,
+            "must hold finite numbers",
+        )
+    }
+
+    fn aabb(
+        &self,
+        b: &BoxSection,
+        dims: usize,
+        key: &str,
+        spacing: f64,
+    ) -> Result<Aabb, SceneError> {
+        self.vector(&b.min, dims, &format!("{key}.min"))?;
+        self.vector(&b.max, dims, &format!("{key}.max"))?;
+        for d in 0..dims {
+            self.check(
+                b.max[d] - b.min[d] >= spacing,
+                &format!("{key}.max"),
+                format!(
+                    "must exceed `{key}.min` by at least one particle spacing ({spacing} m) in every axis; axis {d} has {} .. {}",
+                    b.min[d], b.max[d]
+                ),
+            )?;
+        }
+        Ok(Aabb {
+            min: b.min.clone(),
+            max: b.max.clone(),
+        })
+    }
+
+    fn scene(&self, f: SceneFile) -> Result<Scene, SceneError> {
+        let s = &f.simulation;
+        self.check(
+            s.dimensions == 2 || s.dimensions == 3,
+            "simulation.dimensions",
+            format!("= {} is not supported: use 2 or 3", s.dimensions),
+        )?;
+        let dims = s.dimensions as usize;
+        self.positive(s.spacing, "simulation.spacing", "m")?;
+        self.positive(s.end_time, "simulation.end_time", "s")?;
+        self.positive(s.output_interval, "simulation.output_interval", "s")?;
+        self.vector(&s.gravity, dims, "simulation.gravity")?;
+
+        self.check(
+            !f.fluid.is_empty(),
+            "fluid",
+            "is missing: define at least one [[fluid]]",
+        )?;
+        for (k, fl) in f.fluid.iter().enumerate() {
+            let key = format!("fluid[{k}]");
+            self.positive(fl.density, &format!("{key}.density"), "kg/m^3")?;
+            self.check(
+                fl.viscosity.is_finite() && fl.viscosity >= 0.0,
+                &format!("{key}.viscosity"),
+                format!("= {} must be a non-negative number [m^2/s]", fl.viscosity),
+            )?;
+            self.check(
+                f.fluid[..k].iter().all(|o| o.name != fl.name),
+                &format!("{key}.name"),
+                format!("= \"{}\" is defined twice", fl.name),
+            )?;
+        }
+
+        let container = self.aabb(&f.container, dims, "container", s.spacing)?;
+        self.check(
+            !f.fluid_block.is_empty(),
+            "fluid_block",
+            "is missing: define at least one [[fluid_block]]",
+        )?;
+        let mut blocks = Vec::new();
+        for (k, b) in f.fluid_block.iter().enumerate() {
+            let key = format!("fluid_block[{k}]");
+            let fluid = f
+                .fluid
+                .iter()
+                .position(|fl| fl.name == b.fluid)
+                .ok_or_else(|| {
+                    let names: Vec<_> = f
+                        .fluid
+                        .iter()
+                        .map(|fl| format!("\"{}\"", fl.name))
+                        .collect();
+                    self.error(
+                        &format!("{key}.fluid"),
+                        format!(
+                            "= \"{}\" names no [[fluid]]; defined fluids: {}",
+                            b.fluid,
+                            names.join(", ")
+                        ),
+                    )
+                })?;
+            let region = self.aabb(
+                &BoxSection {
+                    min: b.min.clone(),
+                    max: b.max.clone(),
+                },
+                dims,
+                &key,
+                s.spacing,
+            )?;
+            self.check(
+                region.within(&container),
+                &format!("{key}.min"),
+                format!(
+                    "the block {:?} .. {:?} is not inside the container {:?} .. {:?}",
+                    region.min, region.max, container.min, container.max
+                ),
+            )?;
+            blocks.push(Block { fluid, region });
+        }
+        let mut obstacles = Vec::new();
+        for (k, o) in f.obstacle.iter().enumerate() {
+            let key = format!("obstacle[{k}]");
+            let region = self.aabb(o, dims, &key, s.spacing)?;
+            self.check(
+                region.within(&container),
+                &format!("{key}.min"),
+                format!(
+                    "the obstacle {:?} .. {:?} is not inside the container {:?} .. {:?}",
+                    region.min, region.max, container.min, container.max
+                ),
+            )?;
+            obstacles.push(region);
+        }
+
+        let sv = &f.solver;
+        self.check(
+            sv.tolerance > 0.0 && sv.tolerance < 1.0,
+            "solver.tolerance",
+            format!("= {} must lie in (0, 1)", sv.tolerance),
+        )?;
+        self.check(
+            sv.max_iterations >= 1,
+            "solver.max_iterations",
+            "must be at least 1",
+        )?;
+        self.check(
+            (0.0..=1.0).contains(&sv.alpha),
+            "solver.alpha",
+            format!(
+                "= {} must lie in [0, 1] (0: divergence-free only, 1: density-invariant only)",
+                sv.alpha
+            ),
+        )?;
+        self.check(
+            sv.cfl > 0.0 && sv.cfl <= 1.0,
+            "solver.cfl",
+            format!("= {} must lie in (0, 1]", sv.cfl),
+        )?;
+        self.check(
+            (1.0..=2.0).contains(&sv.h_over_dx),
+            "solver.h_over_dx",
+            format!("= {} must lie in [1, 2]", sv.h_over_dx),
+        )?;
+        if let Some(t) = sv.free_surface_threshold {
+            self.check(
+                t > 0.0 && t < dims as f64,
+                "solver.free_surface_threshold",
+                format!("= {t} must lie in (0, {dims}) (∇·r = {dims} inside the fluid)"),
+            )?;
+        }
+
+        let name = match &s.name {
+            Some(n) => n.clone(),
+            None => self
+                .path
+                .file_stem()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene".into()),
+        };
+        Ok(Scene {
+            path: self.path.to_owned(),
+            name,
+            dimensions: dims,
+            spacing: s.spacing,
+            end_time: s.end_time,
+            output_interval: s.output_interval,
+            gravity: s.gravity.clone(),
+            fluids: f.fluid,
+            blocks,
+            container,
+            obstacles,
+            solver: f.solver,
+        })
+    }
+}
+
+/// 1-based line of a dotted key such as `fluid_block[1].fluid` in TOML source, if present.
+fn line_of_key(text: &str, key: &str) -> Option<usize> {
+    let doc = toml_edit::ImDocument::parse(text).ok()?;
+    let mut item = doc.as_item();
+    for part in key.split('.') {
+        let (name, index) = match part.split_once('[') {
+            Some((n, rest)) => (n, rest.trim_end_matches(']').parse::<usize>().ok()),
+            None => (part, None),
+        };
+        item = item.get(name)?;
+        if let Some(k) = index {
+            item = item.get(k)?;
+        }
+    }
+    let span = item.span()?;
+    Some(text[..span.start].matches('\n').count() + 1)
+}

@@ -1,0 +1,440 @@
+//! The state of a run and one projection step, Eq. (5)–(8):
+//! cell list → density and free surface → predictor → PPE → corrector → advection → diagnostics.
+
+use crate::grid::CellList;
+use crate::kernel::{Quintic, SUPPORT_IN_H};
+use crate::lattice;
+use crate::linsolve::{BiCgStab, SolverError, SolverParams};
+use crate::particles::{components, Kind, Particles};
+use crate::ppe::{self, PressureOperator, Role};
+use crate::reduce::{self, fill_vector};
+use crate::scene::{Aabb, Scene};
+use crate::sph::{self, Neighbours};
+use rayon::prelude::*;
+
+/// Viscous time-step limit Δt ≤ C_ν h²/ν.
+const VISCOUS_NUMBER: f64 = 0.125;
+/// Body-force time-step limit Δt ≤ C_g √(h/|g|).
+const BODY_FORCE_NUMBER: f64 = 0.25;
+
+/// Shifting coefficient A of D = A h |u| Δt.
+const SHIFTING_A: f64 = 2.0;
+
+/// A CFL time step below this fraction of the body-force step is a blow-up.
+const COLLAPSE_FRACTION: f64 = 1.0e-3;
+
+/// What one step measured: a row of `stats.csv` (without the wall time).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepStats {
+    pub step: u64,
+    pub time: f64,
+    pub dt: f64,
+    pub ppe_iterations: usize,
+    pub ppe_residual: f64,
+    pub max_speed: f64,
+    pub kinetic_energy: f64,
+    pub density_error: f64,
+    pub penetrations: usize,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum NumericalFailure {
+    #[error("particle {id} left the domain at step {step} (t = {time} s), at {position:?}")]
+    LeftDomain {
+        id: u64,
+        step: u64,
+        time: f64,
+        position: Vec<f64>,
+    },
+    #[error("the pressure solve failed at step {step} (t = {time} s): {source}")]
+    Solver {
+        step: u64,
+        time: f64,
+        source: SolverError,
+    },
+    #[error("the velocity became non-finite at step {step} (t = {time} s)")]
+    NonFinite { step: u64, time: f64 },
+    #[error("the time step collapsed to {dt:e} s at step {step} (t = {time} s): the flow has blown up (max speed {max_speed:e} m/s)")]
+    TimeStepCollapse {
+        step: u64,
+        time: f64,
+        dt: f64,
+        max_speed: f64,
+    },
+}
+
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: the scene holds no fluid particle: every [[fluid_block]] is thinner than the spacing or lies inside obstacles")]
+pub struct NoFluid {
+    pub path: std::path::PathBuf,
+}
+
+/// Per-step scratch arrays, allocated once and reused.
+struct Workspace<const D: usize> {
+    cell_of: Vec<u32>,
+    order: Vec<u32>,
+    scratch: Vec<f64>,
+    /// Summation density and ∇·r of the step.
+    density_divr: [Vec<f64>; 2],
+    roles: Vec<Role>,
+    full_support: Vec<bool>,
+    u_star: [Vec<f64>; D],
+    /// ĉ_i of the consistent Laplacian.
+    consistency: [Vec<f64>; D],
+    /// Velocity correction Δt ∇P/ρ of the corrector.
+    correction: [Vec<f64>; D],
+    rhs: Vec<f64>,
+    pressure: Vec<f64>,
+    bicgstab: BiCgStab,
+}
+
+impl<const D: usize> Default for Workspace<D> {
+    fn default() -> Self {
+        Self {
+            cell_of: Vec::new(),
+            order: Vec::new(),
+            scratch: Vec::new(),
+            density_divr: components(),
+            roles: Vec::new(),
+            full_support: Vec::new(),
+            u_star: components(),
+            correction: components(),
+            consistency: components(),
+            rhs: Vec::new(),
+            pressure: Vec::new(),
+            bicgstab: BiCgStab::default(),
+        }
+    }
+}
+
+pub struct Simulation<const D: usize> {
+    pub particles: Particles<D>,
+    pub time: f64,
+    pub step: u64,
+    kernel: Quintic<D>,
+    grid: CellList<D>,
+    gravity: [f64; D],
+    container: Aabb,
+    obstacles: Vec<Aabb>,
+    spacing: f64,
+    cfl: f64,
+    alpha: f64,
+    free_surface_threshold: f64,
+    solver: SolverParams,
+    max_viscosity: f64,
+    work: Workspace<D>,
+}
+
+impl<const D: usize> Simulation<D> {
+    pub fn new(scene: &Scene) -> Result<Self, NoFluid> {
+        assert_eq!(
+            scene.dimensions, D,
+            "scene dimension and solver dimension differ"
+        );
+        let particles = lattice::build::<D>(scene);
+        if particles.fluid_count() == 0 {
+            return Err(NoFluid {
+                path: scene.path.clone(),
+            });
+        }
+        let h = scene.smoothing_length();
+        let margin = (lattice::wall_layers(scene) as f64 + 1.0) * scene.spacing;
+        let lo = std::array::from_fn(|d| scene.container.min[d] - margin);
+        let hi = std::array::from_fn(|d| scene.container.max[d] + margin);
+        Ok(Self {
+            particles,
+            time: 0.0,
+            step: 0,
+            kernel: Quintic::new(h),
+            grid: CellList::new(lo, hi, SUPPORT_IN_H * h),
+            gravity: std::array::from_fn(|d| scene.gravity[d]),
+            container: scene.container.clone(),
+            obstacles: scene.obstacles.clone(),
+            spacing: scene.spacing,
+            cfl: scene.solver.cfl,
+            alpha: scene.solver.alpha,
+            free_surface_threshold: scene.free_surface_threshold(),
+            solver: SolverParams {
+                tolerance: scene.solver.tolerance,
+                max_iterations: scene.solver.max_iterations,
+            },
+            max_viscosity: scene.fluids.iter().map(|f| f.viscosity).fold(0.0, f64::max),
+            work: Workspace::default(),
+        })
+    }
+
+    pub fn kernel(&self) -> Quintic<D> {
+        self.kernel
+    }
+
+    /// Largest stable Δt: CFL, viscous and body-force limits. A CFL step far below the
+    /// body-force step means the flow has blown up: that is reported, not integrated.
+    pub fn time_step_limit(&self) -> Result<f64, NumericalFailure> {
+        let p = &self.particles;
+        let h = self.kernel.h();
+        let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
+        let g = self.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+        let (cfl, body_force) = (self.cfl * h / max_speed, BODY_FORCE_NUMBER * (h / g).sqrt());
+        let dt = cfl
+            .min(body_force)
+            .min(VISCOUS_NUMBER * h * h / self.max_viscosity);
+        if cfl < COLLAPSE_FRACTION * body_force {
+            return Err(NumericalFailure::TimeStepCollapse {
+                step: self.step,
+                time: self.time,
+                dt,
+                max_speed,
+            });
+        }
+        Ok(dt)
+    }
+
+    /// Re-sorts the particles by cell, permuting every array together.
+    fn sort_by_cell(&mut self) -> Result<(), NumericalFailure> {
+        let w = &mut self.work;
+        if let Err(out) = self
+            .grid
+            .sort(&self.particles.pos, &mut w.cell_of, &mut w.order)
+        {
+            let p = &self.particles;
+            return Err(NumericalFailure::LeftDomain {
+                id: p.id[out.index],
+                step: self.step,
+                time: self.time,
+                position: p.position(out.index).to_vec(),
+            });
+        }
+        self.particles.permute(&w.order, &mut w.scratch);
+        Ok(())
+    }
+
+    /// Advances by one step towards the simulated time `target`, landing on it exactly when it
+    /// is within reach (two steps to go are split evenly, so no step is tiny).
+    pub fn advance_towards(&mut self, target: f64) -> Result<StepStats, NumericalFailure> {
+        self.sort_by_cell()?;
+        let limit = self.time_step_limit()?;
+        let remaining = target - self.time;
+        let dt = if remaining <= limit {
+            remaining
+        } else if remaining < 2.0 * limit {
+            0.5 * remaining
+        } else {
+            limit
+        };
+        let stats = self.project(dt)?;
+        self.time = if dt == remaining {
+            target
+        } else {
+            self.time + dt
+        };
+        self.finish_step(dt, stats)
+    }
+
+    /// The projection step of size `dt` on particles sorted by cell; returns
+    /// (PPE iterations, PPE residual, density error).
+    fn project(&mut self, dt: f64) -> Result<(usize, f64, f64), NumericalFailure> {
+        let (step, time) = (self.step, self.time);
+        let Self {
+            particles: p,
+            work: w,
+            grid,
+            kernel,
+            gravity,
+            ..
+        } = self;
+        let gravity = *gravity;
+        let nb = Neighbours::new(grid, &p.pos, *kernel);
+
+        // Summation density and ∇·r; walls keep their rest density.
+        for a in w
+            .density_divr
+            .iter_mut()
+            .chain(&mut w.u_star)
+            .chain(&mut w.correction)
+            .chain(&mut w.consistency)
+        {
+            a.resize(p.len(), 0.0);
+        }
+        fill_vector(&mut w.density_divr, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let (rho, div_r) = sph::density_and_position_divergence(&nb, p, i);
+                [rho, div_r]
+            }
+            Kind::Wall => [p.rest_density[i], D as f64],
+        });
+        std::mem::swap(&mut p.density, &mut w.density_divr[0]);
+        let div_r = &w.density_divr[1];
+        ppe::assign_roles(
+            &nb,
+            p,
+            div_r,
+            self.free_surface_threshold,
+            gravity,
+            &mut w.roles,
+        );
+        ppe::full_support(&nb, &w.roles, &mut w.full_support);
+
+        // Predictor, Eq. (5): u* = uⁿ + Δt (ν∇²uⁿ + g); walls stay at rest.
+        fill_vector(&mut w.u_star, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let visc = sph::viscous_acceleration(&nb, p, i);
+                std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + gravity[d]))
+            }
+            Kind::Wall => [0.0; D],
+        });
+
+        // PPE, Eq. (6), solved from the last pressure (warm start).
+        ppe::source(
+            &nb,
+            p,
+            &w.roles,
+            &w.full_support,
+            &w.u_star,
+            dt,
+            self.alpha,
+            gravity,
+            &mut w.rhs,
+        );
+        w.pressure.clone_from(&p.pressure);
+        fill_vector(&mut w.consistency, |i| {
+            ppe::laplacian_correction(&nb, p, &w.roles, i)
+        });
+        let op = PressureOperator {
+            nb: &nb,
+            p,
+            roles: &w.roles,
+            consistency: &w.consistency,
+        };
+        let info = w
+            .bicgstab
+            .solve(&op, &w.rhs, &mut w.pressure, self.solver)
+            .map_err(|source| NumericalFailure::Solver { step, time, source })?;
+        std::mem::swap(&mut p.pressure, &mut w.pressure);
+        ppe::clip_tension(&mut p.pressure);
+
+        // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ)∇Pⁿ⁺¹. Free-surface particles sit on the
+        // Dirichlet boundary, where a one-sided gradient is unreliable (it makes them sink or
+        // bounce off the fluid): they take the kernel average of the correction of the
+        // interior fluid around them; with no interior neighbour (splashes, the tip of a
+        // surge) their own corrected gradient, in which only walls have pressure.
+        fill_vector(&mut w.correction, |i| match w.roles[i] {
+            Role::Interior => sph::pressure_acceleration(&nb, p, i).map(|a| dt * a),
+            _ => [0.0; D],
+        });
+        let mut vel = std::mem::replace(&mut p.vel, components());
+        fill_vector(&mut vel, |i| {
+            let correction: [f64; D] = match w.roles[i] {
+                Role::Surface => sph::interior_average(&nb, p, &w.roles, &w.correction, i)
+                    .unwrap_or_else(|| sph::pressure_acceleration(&nb, p, i).map(|a| dt * a)),
+                _ => std::array::from_fn(|d| w.correction[d][i]),
+            };
+            match p.kind[i] {
+                Kind::Fluid => std::array::from_fn(|d| w.u_star[d][i] - correction[d]),
+                Kind::Wall => [0.0; D],
+            }
+        });
+        p.vel = vel;
+
+        // Density error where the summation density is not truncated by the free surface.
+        let full = &w.full_support;
+        let n_full = full.iter().filter(|&&f| f).count();
+        let density_error = if n_full == 0 {
+            0.0
+        } else {
+            reduce::sum(p.len(), |i| {
+                if full[i] {
+                    (p.density[i] / p.rest_density[i] - 1.0).abs()
+                } else {
+                    0.0
+                }
+            }) / n_full as f64
+        };
+
+        // Advection, Eq. (8), with Fickian shifting δr = −D ∇C (Eq. 10), D = A h |u| Δt
+        // (Skillen et al. 2013), each component capped at 0.1 dx; not at the free surface,
+        // where ∇C points out of the fluid, unless the particle is compressed.
+        let h = kernel.h();
+        fill_vector(&mut w.correction, |i| match w.roles[i] {
+            // Clumps flagged as surface (∇·r barely sees near-coincident pairs) are shifted too.
+            Role::Interior | Role::Surface
+                if w.roles[i] == Role::Interior || p.density[i] > p.rest_density[i] =>
+            {
+                let u = speed(p, i);
+                let grad_c = sph::concentration_gradient(&nb, p, i);
+                let cap = 0.1 * self.spacing;
+                grad_c.map(|g| (-SHIFTING_A * h * u * dt * g).clamp(-cap, cap))
+            }
+            _ => [0.0; D],
+        });
+        for d in 0..D {
+            let (kind, shift) = (&p.kind, &w.correction[d]);
+            p.pos[d]
+                .par_iter_mut()
+                .zip(&p.vel[d])
+                .zip(kind)
+                .zip(shift)
+                .for_each(|(((x, v), k), s)| {
+                    if *k == Kind::Fluid {
+                        *x += dt * v + s;
+                    }
+                });
+        }
+        Ok((info.iterations, info.relative_residual, density_error))
+    }
+
+    fn finish_step(
+        &mut self,
+        dt: f64,
+        (ppe_iterations, ppe_residual, density_error): (usize, f64, f64),
+    ) -> Result<StepStats, NumericalFailure> {
+        self.step += 1;
+        let p = &self.particles;
+        let fluid = |i: usize| p.is_fluid(i);
+        let max_speed = reduce::max(p.len(), |i| if fluid(i) { speed(p, i) } else { 0.0 });
+        if !max_speed.is_finite() {
+            return Err(NumericalFailure::NonFinite {
+                step: self.step,
+                time: self.time,
+            });
+        }
+        let kinetic_energy = reduce::sum(p.len(), |i| {
+            if fluid(i) {
+                0.5 * p.mass[i] * speed(p, i).powi(2)
+            } else {
+                0.0
+            }
+        });
+        Ok(StepStats {
+            step: self.step,
+            time: self.time,
+            dt,
+            ppe_iterations,
+            ppe_residual,
+            max_speed,
+            kinetic_energy,
+            density_error,
+            penetrations: self.penetrations(),
+        })
+    }
+
+    /// Fluid particles whose centre lies inside a wall: outside the container or in an obstacle.
+    pub fn penetrations(&self) -> usize {
+        let p = &self.particles;
+        reduce::count(p.len(), |i| {
+            if !p.is_fluid(i) {
+                return false;
+            }
+            let x = p.position(i);
+            let c = &self.container;
+            let outside = (0..D).any(|d| x[d] < c.min[d] || x[d] > c.max[d]);
+            outside || self.obstacles.iter().any(|o| o.contains(&x))
+        })
+    }
+}
+
+fn speed<const D: usize>(p: &Particles<D>, i: usize) -> f64 {
+    (0..D)
+        .map(|d| p.vel[d][i] * p.vel[d][i])
+        .sum::<f64>()
+        .sqrt()
+}

@@ -1,0 +1,247 @@
+//! SPH discretisation: the one pair loop every operator is built on, and the operators of
+//! Eq. (20)–(27) written as per-particle sums over it.
+
+use crate::grid::CellList;
+use crate::kernel::Quintic;
+use crate::particles::{Kind, Particles};
+use crate::ppe::Role;
+
+/// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
+const ETA2_IN_H2: f64 = 1.0e-4;
+
+/// The neighbourhood of every particle: positions sorted by cell plus the kernel.
+pub struct Neighbours<'a, const D: usize> {
+    grid: &'a CellList<D>,
+    pos: &'a [Vec<f64>; D],
+    pub kernel: Quintic<D>,
+    support2: f64,
+    eta2: f64,
+}
+
+impl<'a, const D: usize> Neighbours<'a, D> {
+    pub fn new(grid: &'a CellList<D>, pos: &'a [Vec<f64>; D], kernel: Quintic<D>) -> Self {
+        let support2 = kernel.support() * kernel.support();
+        let eta2 = ETA2_IN_H2 * kernel.h() * kernel.h();
+        Self {
+            grid,
+            pos,
+            kernel,
+            support2,
+            eta2,
+        }
+    }
+
+    /// The pair loop: calls `f(j, r_ij, |r_ij|)` for every particle j ≠ i inside the kernel
+    /// support of i, walking the contiguous cell ranges around i.
+    #[inline]
+    pub fn for_each(&self, i: usize, mut f: impl FnMut(usize, [f64; D], f64)) {
+        let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
+        self.grid.for_each_neighbour_range(xi, |range| {
+            for j in range {
+                let rij: [f64; D] = std::array::from_fn(|d| xi[d] - self.pos[d][j]);
+                let r2: f64 = rij.iter().map(|x| x * x).sum();
+                if r2 < self.support2 && j != i {
+                    f(j, rij, r2.sqrt());
+                }
+            }
+        });
+    }
+
+    /// r_ij·∇W_ij / (r_ij² + η²), the radial factor shared by Eq. (26) and Eq. (27).
+    #[inline]
+    pub fn laplacian_factor(&self, r: f64) -> f64 {
+        r * r * self.kernel.grad_factor(r) / (r * r + self.eta2)
+    }
+}
+
+/// Summation density ρ_i = Σ_j m_j W_ij (self included) and the position divergence
+/// ∇·r_i = −Σ_j V_j r_ij·∇W_ij with V_j = m_j/ρ0_j, used to find the free surface.
+pub fn density_and_position_divergence<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> (f64, f64) {
+    let mut rho = p.mass[i] * nb.kernel.w(0.0);
+    let mut div_r = 0.0;
+    nb.for_each(i, |j, _, r| {
+        rho += p.mass[j] * nb.kernel.w(r);
+        div_r -= p.mass[j] / p.rest_density[j] * r * r * nb.kernel.grad_factor(r);
+    });
+    (rho, div_r)
+}
+
+/// Laminar viscous acceleration ∇·(ν∇u)_i of Eq. (26). Wall particles are at rest and take
+/// the fluid's viscosity (no-slip).
+pub fn viscous_acceleration<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> [f64; D] {
+    let (rho_i, nu_i) = (p.density[i], p.viscosity[i]);
+    let mut acc = [0.0; D];
+    nb.for_each(i, |j, _, r| {
+        let nu_j = if p.kind[j] == Kind::Wall {
+            nu_i
+        } else {
+            p.viscosity[j]
+        };
+        let rho_j = p.density[j];
+        let c =
+            p.mass[j] * (rho_i * nu_i + rho_j * nu_j) / (rho_i * rho_j) * nb.laplacian_factor(r);
+        for d in 0..D {
+            acc[d] += c * (p.vel[d][i] - p.vel[d][j]);
+        }
+    });
+    acc
+}
+
+/// Smallest determinant of the moment matrix M_i for which the kernel gradient correction is
+/// applied; below it (splashes, thin sheets, lone particles) the plain gradient is used.
+const MIN_CORRECTION_DETERMINANT: f64 = 0.1;
+
+/// Kernel gradient correction L_i = M_i⁻¹, M_i = Σ_j V_j ∇W_ij ⊗ r_ji, Eq. (24)–(25), so that
+/// L_i Σ_j V_j (φ_j − φ_i) ∇W_ij is exact for linear φ even where the support is truncated.
+/// None where M_i is near-singular.
+pub fn gradient_correction<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> Option<[[f64; D]; D]> {
+    let mut m = [[0.0; D]; D];
+    nb.for_each(i, |j, rij, r| {
+        let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
+        for a in 0..D {
+            for b in 0..D {
+                m[a][b] -= vf * rij[a] * rij[b];
+            }
+        }
+    });
+    invert(m)
+        .filter(|(_, det)| *det > MIN_CORRECTION_DETERMINANT)
+        .map(|(l, _)| l)
+}
+
+/// Inverse and determinant of a small matrix (Gauss–Jordan with partial pivoting).
+pub fn invert<const D: usize>(mut m: [[f64; D]; D]) -> Option<([[f64; D]; D], f64)> {
+    let mut inv = [[0.0; D]; D];
+    for (k, row) in inv.iter_mut().enumerate() {
+        row[k] = 1.0;
+    }
+    let mut det = 1.0;
+    for c in 0..D {
+        let pivot = (c..D).max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()))?;
+        if m[pivot][c] == 0.0 {
+            return None;
+        }
+        if pivot != c {
+            m.swap(pivot, c);
+            inv.swap(pivot, c);
+            det = -det;
+        }
+        let d = m[c][c];
+        det *= d;
+        for k in 0..D {
+            m[c][k] /= d;
+            inv[c][k] /= d;
+        }
+        for r in (0..D).filter(|&r| r != c) {
+            let f = m[r][c];
+            for k in 0..D {
+                m[r][k] -= f * m[c][k];
+                inv[r][k] -= f * inv[c][k];
+            }
+        }
+    }
+    Some((inv, det))
+}
+
+/// Applies L_i to a vector (identity where the correction is off).
+#[inline]
+pub fn apply_correction<const D: usize>(l: &Option<[[f64; D]; D]>, v: [f64; D]) -> [f64; D] {
+    match l {
+        Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[a][b] * v[b]).sum()),
+        None => v,
+    }
+}
+
+/// Corrected gradient of a scalar field, ∇φ_i = L_i Σ_j V_j (φ_j − φ_i) ∇W_ij, Eq. (20) with
+/// Eq. (24)–(25): exact for linear φ also where the kernel support is truncated.
+pub fn gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    phi: &[f64],
+    l: &Option<[[f64; D]; D]>,
+    i: usize,
+) -> [f64; D] {
+    let mut grad = [0.0; D];
+    nb.for_each(i, |j, rij, r| {
+        let c = p.mass[j] / p.density[j] * (phi[j] - phi[i]) * nb.kernel.grad_factor(r);
+        for d in 0..D {
+            grad[d] += c * rij[d];
+        }
+    });
+    apply_correction(l, grad)
+}
+
+/// Pressure acceleration (1/ρ_i)∇P_i with the corrected gradient. The symmetric form of
+/// Eq. (23) sees only part of the kernel support at the free surface, where it lets surface
+/// particles sink into the fluid; the corrected form keeps a hydrostatic surface at rest.
+pub fn pressure_acceleration<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> [f64; D] {
+    let l = gradient_correction(nb, p, i);
+    gradient(nb, p, &p.pressure, &l, i).map(|g| g / p.density[i])
+}
+
+/// Kernel average Σ_j W_ij f_j / Σ_j W_ij of a vector field over the interior fluid
+/// neighbours of i, or None when i has none.
+pub fn interior_average<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    roles: &[Role],
+    f: &[Vec<f64>; D],
+    i: usize,
+) -> Option<[f64; D]> {
+    let (mut wsum, mut sum) = (0.0, [0.0; D]);
+    nb.for_each(i, |j, _, r| {
+        if roles[j] == Role::Interior && p.is_fluid(j) {
+            let w = nb.kernel.w(r);
+            wsum += w;
+            for d in 0..D {
+                sum[d] += w * f[d][j];
+            }
+        }
+    });
+    (wsum > 0.0).then(|| sum.map(|s| s / wsum))
+}
+
+/// Gradient of the particle concentration ∇C_i = Σ_j V_j ∇W_ij, V_j = m_j/ρ0_j (Eq. 10).
+pub fn concentration_gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> [f64; D] {
+    let mut g = [0.0; D];
+    nb.for_each(i, |j, rij, r| {
+        let c = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
+        for d in 0..D {
+            g[d] += c * rij[d];
+        }
+    });
+    g
+}
+
+/// Coefficient a_ij ≥ 0 of the negative Laplacian of Eq. (27):
+/// −∇²P_i = Σ_j a_ij (P_i − P_j), a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²).
+#[inline]
+pub fn laplacian_coefficient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+    j: usize,
+    r: f64,
+) -> f64 {
+    -2.0 * p.mass[j] / p.density[i] * nb.laplacian_factor(r)
+}

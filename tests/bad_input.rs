@@ -1,0 +1,179 @@
+//! Bad input: one clear paragraph naming the file and key (and line), exit code ≠ 0, no panic,
+//! and nothing already written is touched.
+
+use crate::common::TempDir;
+use std::path::Path;
+use std::process::{Command, Output};
+
+const GOOD: &str = r#"[simulation]
+dimensions = 2
+spacing = 0.02
+end_time = 0.01
+output_interval = 0.01
+gravity = [0.0, -9.81]
+
+[[fluid]]
+name = "water"
+density = 1000.0
+viscosity = 1.0e-6
+
+[[fluid_block]]
+fluid = "water"
+min = [0.0, 0.0]
+max = [0.2, 0.2]
+
+[container]
+min = [0.0, 0.0]
+max = [0.4, 0.3]
+"#;
+
+fn isph(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_isph"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Runs `isph run` on `scene` text and returns (exit code, stderr).
+fn run_text(dir: &Path, scene: &str, extra: &[&str]) -> (i32, String) {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.join("out");
+    let mut args = vec![
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let o = isph(&args);
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn assert_refused(code: i32, stderr: &str, expected: &[&str]) {
+    assert_ne!(code, 0, "accepted; stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for e in expected {
+        assert!(stderr.contains(e), "`{e}` missing from: {stderr}");
+    }
+}
+
+#[test]
+fn each_bad_scene_is_refused_with_its_key_and_line() {
+    let dir = TempDir::new("bad-input");
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            "spacing = 0.02",
+            "spacing = -0.02",
+            &["simulation.spacing", "scene.toml:3", "positive"],
+        ),
+        (
+            "dimensions = 2",
+            "dimensions = 4",
+            &["simulation.dimensions", "scene.toml:2", "2 or 3"],
+        ),
+        (
+            "gravity = [0.0, -9.81]",
+            "gravity = [0.0, -9.81, 0.0]",
+            &["simulation.gravity", ":6", "3 components"],
+        ),
+        (
+            "max = [0.2, 0.2]",
+            "max = [0.2, 0.5]",
+            &["fluid_block[0]", "not inside the container"],
+        ),
+        (
+            "fluid = \"water\"",
+            "fluid = \"oil\"",
+            &[
+                "fluid_block[0].fluid",
+                "scene.toml:14",
+                "\"oil\"",
+                "\"water\"",
+            ],
+        ),
+        (
+            "viscosity = 1.0e-6",
+            "viscosity = 1.0e-6\ncolour = 3",
+            &["unknown field `colour`", "line 12"],
+        ),
+        (
+            "end_time = 0.01",
+            "end_time = [0.01",
+            &["line 5", "TOML parse error", "expected `]`"],
+        ),
+    ];
+    for (from, to, expected) in cases {
+        let (code, stderr) = run_text(dir.path(), &GOOD.replace(from, to), &[]);
+        assert_refused(code, &stderr, expected);
+        assert!(stderr.contains("scene.toml"), "file not named: {stderr}");
+    }
+}
+
+#[test]
+fn a_missing_file_is_refused() {
+    let o = isph(&["run", "/nonexistent/scene.toml", "-q"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_refused(
+        o.status.code().unwrap_or(-1),
+        &stderr,
+        &["/nonexistent/scene.toml", "cannot read"],
+    );
+}
+
+#[test]
+fn an_unwritable_output_directory_is_refused() {
+    let dir = TempDir::new("unwritable");
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, GOOD).unwrap();
+    let out = file.join("out");
+    let o = isph(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_refused(
+        o.status.code().unwrap_or(-1),
+        &stderr,
+        &["output directory", "cannot be used"],
+    );
+}
+
+#[test]
+fn an_existing_run_is_never_overwritten_by_accident() {
+    let dir = TempDir::new("existing-run");
+    let (code, stderr) = run_text(dir.path(), GOOD, &[]);
+    assert_eq!(code, 0, "{stderr}");
+    let h5 = dir.path().join("out/particles.h5");
+    let before = std::fs::read(&h5).unwrap();
+    let (code, stderr) = run_text(dir.path(), GOOD, &[]);
+    assert_refused(code, &stderr, &["already holds a run", "--overwrite"]);
+    assert_eq!(
+        std::fs::read(&h5).unwrap(),
+        before,
+        "the earlier run was modified"
+    );
+    let (code, stderr) = run_text(dir.path(), GOOD, &["--overwrite"]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+#[test]
+fn resume_says_it_is_not_available_yet() {
+    let o = isph(&["resume", "out/x/checkpoints/c.ckpt"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_refused(
+        o.status.code().unwrap_or(-1),
+        &stderr,
+        &["not available yet"],
+    );
+}

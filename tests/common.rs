@@ -1,0 +1,127 @@
+//! Shared helpers: lattices of particles sorted into a cell list, scenes, and runs.
+
+use isph::grid::CellList;
+use isph::kernel::{Quintic, SUPPORT_IN_H};
+use isph::particles::{Kind, NewParticle, Particles};
+use isph::run::{run, RunOptions, RunSummary};
+use isph::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// A block of `n` fluid particles per axis at spacing `dx` around the origin, sorted by cell.
+pub struct Lattice<const D: usize> {
+    pub particles: Particles<D>,
+    pub grid: CellList<D>,
+    pub kernel: Quintic<D>,
+}
+
+impl<const D: usize> Lattice<D> {
+    pub fn new(n: i64, dx: f64, h_over_dx: f64) -> Self {
+        let mut particles = Particles::<D>::default();
+        let half = n / 2;
+        let total = (n as usize).pow(D as u32);
+        for k in 0..total {
+            let mut rest = k as i64;
+            let pos = std::array::from_fn(|_| {
+                let c = rest % n;
+                rest /= n;
+                (c - half) as f64 * dx
+            });
+            particles.push(NewParticle {
+                pos,
+                kind: Kind::Fluid,
+                fluid: 0,
+                mass: 1000.0 * dx.powi(D as i32),
+                rest_density: 1000.0,
+                viscosity: 0.0,
+            });
+        }
+        let kernel = Quintic::<D>::new(h_over_dx * dx);
+        let extent = (half + 2) as f64 * dx;
+        let mut grid = CellList::new([-extent; D], [extent; D], SUPPORT_IN_H * kernel.h());
+        let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
+        grid.sort(&particles.pos, &mut cells, &mut order)
+            .expect("lattice inside grid");
+        particles.permute(&order, &mut scratch);
+        Self {
+            particles,
+            grid,
+            kernel,
+        }
+    }
+
+    /// Index of the particle nearest the origin.
+    pub fn centre(&self) -> usize {
+        let p = &self.particles;
+        (0..p.len())
+            .min_by(|&a, &b| {
+                let r = |i: usize| (0..D).map(|d| p.pos[d][i].powi(2)).sum::<f64>();
+                r(a).total_cmp(&r(b))
+            })
+            .unwrap()
+    }
+}
+
+/// A temporary directory removed when dropped.
+pub struct TempDir(pub PathBuf);
+
+impl TempDir {
+    pub fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("isph-test-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Loads a scene shipped in `scenes/`.
+pub fn shipped_scene(name: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Runs `scene` quietly into `out` until `until`.
+pub fn run_scene(scene: &Scene, out: &Path, until: f64) -> RunSummary {
+    let opts = RunOptions {
+        out: out.to_owned(),
+        until: Some(until),
+        overwrite: true,
+        quiet: true,
+    };
+    run(scene, &opts).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Reads one frame's dataset from a run's particles.h5.
+pub fn read_frame<T: hdf5::H5Type>(out: &Path, frame: usize, name: &str) -> Vec<T> {
+    let file = hdf5::File::open(out.join("particles.h5")).unwrap();
+    file.dataset(&format!("frame_{frame:06}/{name}"))
+        .unwrap()
+        .read_raw::<T>()
+        .unwrap()
+}
+
+/// Column `name` of a run's stats.csv.
+pub fn stats_column(out: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(out.join("stats.csv")).unwrap();
+    let mut lines = text.lines();
+    let col = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|c| c == name)
+        .expect("column");
+    lines
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect()
+}

@@ -1,0 +1,13 @@
+//! One integration-test binary (habit 7 of STYLE.md): physics, numerics, output and bad input.
+
+mod common;
+
+mod bad_input;
+mod dam_break;
+mod determinism;
+mod hydrostatic;
+mod kernel;
+mod linsolve;
+mod neighbours;
+mod operators;
+mod output_readers;

@@ -1,0 +1,84 @@
+//! The cell-list pair loop against a brute-force O(N²) search (its slow, obvious twin).
+
+use isph::grid::CellList;
+use isph::kernel::{Quintic, SUPPORT_IN_H};
+use isph::particles::{Kind, NewParticle, Particles};
+use isph::sph::Neighbours;
+
+/// A small deterministic pseudo-random sequence in [0, 1).
+fn lcg(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64
+}
+
+fn check<const D: usize>(n: usize) {
+    let mut seed = 42;
+    let mut p = Particles::<D>::default();
+    for _ in 0..n {
+        let pos = std::array::from_fn(|_| lcg(&mut seed));
+        p.push(NewParticle {
+            pos,
+            kind: Kind::Fluid,
+            fluid: 0,
+            mass: 1.0,
+            rest_density: 1.0,
+            viscosity: 0.0,
+        });
+    }
+    let kernel = Quintic::<D>::new(0.04);
+    let mut grid = CellList::new([0.0; D], [1.0; D], SUPPORT_IN_H * kernel.h());
+    let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
+    grid.sort(&p.pos, &mut cells, &mut order).unwrap();
+    p.permute(&order, &mut scratch);
+    let nb = Neighbours::new(&grid, &p.pos, kernel);
+    let s2 = kernel.support().powi(2);
+    for i in 0..n {
+        let mut fast = Vec::new();
+        nb.for_each(i, |j, _, _| fast.push(j));
+        fast.sort();
+        let slow: Vec<usize> = (0..n)
+            .filter(|&j| {
+                j != i
+                    && (0..D)
+                        .map(|d| (p.pos[d][i] - p.pos[d][j]).powi(2))
+                        .sum::<f64>()
+                        < s2
+            })
+            .collect();
+        assert_eq!(fast, slow, "neighbours of particle {i}");
+    }
+}
+
+#[test]
+fn cell_list_finds_exactly_the_brute_force_neighbours() {
+    check::<2>(3000);
+    check::<3>(3000);
+}
+
+#[test]
+fn sort_keeps_ids_and_reports_particles_outside() {
+    let mut p = Particles::<2>::default();
+    for x in [0.9, 0.1, 0.5] {
+        p.push(NewParticle {
+            pos: [x, 0.5],
+            kind: Kind::Fluid,
+            fluid: 0,
+            mass: 1.0,
+            rest_density: 1.0,
+            viscosity: 0.0,
+        });
+    }
+    let mut grid = CellList::new([0.0; 2], [1.0; 2], 0.1);
+    let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
+    grid.sort(&p.pos, &mut cells, &mut order).unwrap();
+    p.permute(&order, &mut scratch);
+    assert_eq!(p.id, vec![1, 2, 0]);
+    assert_eq!(p.pos[0], vec![0.1, 0.5, 0.9]);
+    p.pos[0][1] = 7.0;
+    assert_eq!(
+        grid.sort(&p.pos, &mut cells, &mut order).unwrap_err().index,
+        1
+    );
+}
