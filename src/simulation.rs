@@ -7,7 +7,7 @@ use crate::lattice;
 use crate::linsolve::{BiCgStab, SolverError, SolverParams};
 use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
-use crate::reduce::{self, fill_vector};
+use crate::reduce::{self, fill, fill_vector};
 use crate::scene::{Aabb, Scene};
 use crate::sph::{self, Neighbours};
 use rayon::prelude::*;
@@ -16,6 +16,9 @@ use rayon::prelude::*;
 const VISCOUS_NUMBER: f64 = 0.125;
 /// Body-force time-step limit Δt ≤ C_g √(h/|g|).
 const BODY_FORCE_NUMBER: f64 = 0.25;
+
+/// Smagorinsky constant Cs of Eq. (3)–(4), Δ = dx.
+const SMAGORINSKY: f64 = 0.2;
 
 /// Shifting coefficient A of D = A h |u| Δt.
 const SHIFTING_A: f64 = 2.0;
@@ -79,6 +82,8 @@ struct Workspace<const D: usize> {
     roles: Vec<Role>,
     full_support: Vec<bool>,
     u_star: [Vec<f64>; D],
+    /// Smagorinsky eddy viscosity ν_t.
+    eddy: Vec<f64>,
     /// ĉ_i of the consistent Laplacian.
     consistency: [Vec<f64>; D],
     /// Velocity correction Δt ∇P/ρ of the corrector.
@@ -100,6 +105,7 @@ impl<const D: usize> Default for Workspace<D> {
             u_star: components(),
             correction: components(),
             consistency: components(),
+            eddy: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
             bicgstab: BiCgStab::default(),
@@ -274,10 +280,18 @@ impl<const D: usize> Simulation<D> {
         );
         ppe::full_support(&nb, &w.roles, &mut w.full_support);
 
+        // Smagorinsky eddy viscosity, Eq. (3)–(4).
+        w.eddy.resize(p.len(), 0.0);
+        let cs_delta = SMAGORINSKY * self.spacing;
+        fill(&mut w.eddy, |i| match p.kind[i] {
+            Kind::Fluid if cs_delta > 0.0 => sph::eddy_viscosity(&nb, p, cs_delta, i),
+            _ => 0.0,
+        });
+
         // Predictor, Eq. (5): u* = uⁿ + Δt (ν∇²uⁿ + g); walls stay at rest.
         fill_vector(&mut w.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
-                let visc = sph::viscous_acceleration(&nb, p, i);
+                let visc = sph::viscous_acceleration(&nb, p, &w.eddy, i);
                 std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + gravity[d]))
             }
             Kind::Wall => [0.0; D],
@@ -354,17 +368,18 @@ impl<const D: usize> Simulation<D> {
         // (Skillen et al. 2013), each component capped at 0.1 dx; not at the free surface,
         // where ∇C points out of the fluid, unless the particle is compressed.
         let h = kernel.h();
-        fill_vector(&mut w.correction, |i| match w.roles[i] {
-            // Clumps flagged as surface (∇·r barely sees near-coincident pairs) are shifted too.
-            Role::Interior | Role::Surface
-                if w.roles[i] == Role::Interior || p.density[i] > p.rest_density[i] =>
-            {
+        let full = &w.full_support;
+        fill_vector(&mut w.correction, |i| {
+            // Near the free surface ∇C points out of the fluid because the kernel is truncated;
+            // there only compressed particles (clumps) are shifted.
+            if full[i] || (p.is_fluid(i) && p.density[i] > p.rest_density[i]) {
                 let u = speed(p, i);
                 let grad_c = sph::concentration_gradient(&nb, p, i);
                 let cap = 0.1 * self.spacing;
                 grad_c.map(|g| (-SHIFTING_A * h * u * dt * g).clamp(-cap, cap))
+            } else {
+                [0.0; D]
             }
-            _ => [0.0; D],
         });
         for d in 0..D {
             let (kind, shift) = (&p.kind, &w.correction[d]);

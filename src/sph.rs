@@ -70,20 +70,22 @@ pub fn density_and_position_divergence<const D: usize>(
     (rho, div_r)
 }
 
-/// Laminar viscous acceleration ∇·(ν∇u)_i of Eq. (26). Wall particles are at rest and take
-/// the fluid's viscosity (no-slip).
+/// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, the eddy viscosity of
+/// the Smagorinsky model (Eq. 3–4). Wall particles are at rest and take the fluid's viscosity
+/// (no-slip).
 pub fn viscous_acceleration<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    eddy: &[f64],
     i: usize,
 ) -> [f64; D] {
-    let (rho_i, nu_i) = (p.density[i], p.viscosity[i]);
+    let (rho_i, nu_i) = (p.density[i], p.viscosity[i] + eddy[i]);
     let mut acc = [0.0; D];
     nb.for_each(i, |j, _, r| {
         let nu_j = if p.kind[j] == Kind::Wall {
             nu_i
         } else {
-            p.viscosity[j]
+            p.viscosity[j] + eddy[j]
         };
         let rho_j = p.density[j];
         let c =
@@ -93,6 +95,35 @@ pub fn viscous_acceleration<const D: usize>(
         }
     });
     acc
+}
+
+/// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S|, |S| = (2 S_ab S_ab)^½, S the strain rate of
+/// the corrected velocity gradient (Eq. 3–4); walls are at rest.
+pub fn eddy_viscosity<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, cs_delta: f64, i: usize) -> f64 {
+    let l = gradient_correction(nb, p, i);
+    let mut g = [[0.0; D]; D];
+    nb.for_each(i, |j, rij, r| {
+        let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
+        for a in 0..D {
+            let du = if p.kind[j] == Kind::Wall { 0.0 } else { p.vel[a][j] } - p.vel[a][i];
+            for b in 0..D {
+                g[b][a] += vf * du * rij[b];
+            }
+        }
+    });
+    // Corrected ∂u_a/∂x_b = Σ_c L_bc g[c][a].
+    let grad: [[f64; D]; D] = std::array::from_fn(|b| std::array::from_fn(|a| match &l {
+        Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
+        None => g[b][a],
+    }));
+    let mut ss = 0.0;
+    for a in 0..D {
+        for b in 0..D {
+            let s = 0.5 * (grad[a][b] + grad[b][a]);
+            ss += s * s;
+        }
+    }
+    cs_delta * cs_delta * (2.0 * ss).sqrt()
 }
 
 /// Smallest determinant of the moment matrix M_i for which the kernel gradient correction is
