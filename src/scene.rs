@@ -254,6 +254,28 @@ impl Validator<'_> {
         })
     }
 
+    /// A box section that must lie inside the container.
+    fn region_inside(
+        &self,
+        b: &BoxSection,
+        container: &Aabb,
+        dims: usize,
+        key: &str,
+        spacing: f64,
+        what: &str,
+    ) -> Result<Aabb, SceneError> {
+        let region = self.aabb(b, dims, key, spacing)?;
+        self.check(
+            region.within(container),
+            &format!("{key}.min"),
+            format!(
+                "the {what} {:?} .. {:?} is not inside the container {:?} .. {:?}",
+                region.min, region.max, container.min, container.max
+            ),
+        )?;
+        Ok(region)
+    }
+
     fn scene(&self, f: SceneFile) -> Result<Scene, SceneError> {
         let s = &f.simulation;
         self.check(
@@ -315,37 +337,18 @@ impl Validator<'_> {
                         ),
                     )
                 })?;
-            let region = self.aabb(
-                &BoxSection {
-                    min: b.min.clone(),
-                    max: b.max.clone(),
-                },
-                dims,
-                &key,
-                s.spacing,
-            )?;
-            self.check(
-                region.within(&container),
-                &format!("{key}.min"),
-                format!(
-                    "the block {:?} .. {:?} is not inside the container {:?} .. {:?}",
-                    region.min, region.max, container.min, container.max
-                ),
-            )?;
+            let section = BoxSection {
+                min: b.min.clone(),
+                max: b.max.clone(),
+            };
+            let region =
+                self.region_inside(&section, &container, dims, &key, s.spacing, "block")?;
             blocks.push(Block { fluid, region });
         }
         let mut obstacles = Vec::new();
         for (k, o) in f.obstacle.iter().enumerate() {
             let key = format!("obstacle[{k}]");
-            let region = self.aabb(o, dims, &key, s.spacing)?;
-            self.check(
-                region.within(&container),
-                &format!("{key}.min"),
-                format!(
-                    "the obstacle {:?} .. {:?} is not inside the container {:?} .. {:?}",
-                    region.min, region.max, container.min, container.max
-                ),
-            )?;
+            let region = self.region_inside(o, &container, dims, &key, s.spacing, "obstacle")?;
             obstacles.push(region);
         }
 

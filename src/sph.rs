@@ -99,23 +99,34 @@ pub fn viscous_acceleration<const D: usize>(
 
 /// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S|, |S| = (2 S_ab S_ab)^½, S the strain rate of
 /// the corrected velocity gradient (Eq. 3–4); walls are at rest.
-pub fn eddy_viscosity<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, cs_delta: f64, i: usize) -> f64 {
+pub fn eddy_viscosity<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    cs_delta: f64,
+    i: usize,
+) -> f64 {
     let l = gradient_correction(nb, p, i);
     let mut g = [[0.0; D]; D];
     nb.for_each(i, |j, rij, r| {
         let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
         for a in 0..D {
-            let du = if p.kind[j] == Kind::Wall { 0.0 } else { p.vel[a][j] } - p.vel[a][i];
+            let du = if p.kind[j] == Kind::Wall {
+                0.0
+            } else {
+                p.vel[a][j]
+            } - p.vel[a][i];
             for b in 0..D {
                 g[b][a] += vf * du * rij[b];
             }
         }
     });
     // Corrected ∂u_a/∂x_b = Σ_c L_bc g[c][a].
-    let grad: [[f64; D]; D] = std::array::from_fn(|b| std::array::from_fn(|a| match &l {
-        Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
-        None => g[b][a],
-    }));
+    let grad: [[f64; D]; D] = std::array::from_fn(|b| {
+        std::array::from_fn(|a| match &l {
+            Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
+            None => g[b][a],
+        })
+    });
     let mut ss = 0.0;
     for a in 0..D {
         for b in 0..D {
