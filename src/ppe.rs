@@ -14,7 +14,7 @@
 use crate::linsolve::LinearOperator;
 use crate::particles::{Kind, Particles};
 use crate::reduce::fill;
-use crate::sph::{gradient_correction, laplacian_coefficient, Neighbours};
+use crate::sph::{laplacian_coefficient, Correction, Neighbours};
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,6 +86,7 @@ pub fn source<const D: usize>(
     p: &Particles<D>,
     roles: &[Role],
     full: &[bool],
+    corrections: &[Correction<D>],
     u_star: &[Vec<f64>; D],
     dt: f64,
     alpha: f64,
@@ -94,7 +95,7 @@ pub fn source<const D: usize>(
 ) {
     b.resize(p.len(), 0.0);
     fill(b, |i| match roles[i] {
-        Role::Interior => interior_source(nb, p, u_star, full[i], dt, alpha, i),
+        Role::Interior => interior_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i),
         Role::Wall => {
             let (mut wsum, mut hydro) = (0.0, 0.0);
             nb.for_each(i, |j, rij, r| {
@@ -114,16 +115,17 @@ pub fn source<const D: usize>(
 /// Right-hand side of an interior fluid row: −(ρ0/Δt) ∇·u* − α (ρ0 − ρ_i)/Δt², Eq. (6), with
 /// ∇·u* corrected by Eq. (24)–(25) so that it is exact for linear velocity fields also where
 /// the free surface truncates the kernel support.
+#[allow(clippy::too_many_arguments)]
 fn interior_source<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    l: &Correction<D>,
     u_star: &[Vec<f64>; D],
     full_support: bool,
     dt: f64,
     alpha: f64,
     i: usize,
 ) -> f64 {
-    let l = gradient_correction(nb, p, i);
     let rho_i = p.density[i];
     // Walls take the fluid's own predictor increment u*_i − uⁿ_i: the body force is carried by
     // the hydrostatic term of the wall rows, the wall's kinematic condition by the divergence.
@@ -146,7 +148,7 @@ fn interior_source<const D: usize>(
         }
     });
     // ∇·u = trace(L ∇u), Eq. (22) with Eq. (24)–(25).
-    let div: f64 = match &l {
+    let div: f64 = match l {
         Some(l) => (0..D)
             .map(|a| (0..D).map(|b| l[a][b] * grad_u[b][a]).sum::<f64>())
             .sum(),
@@ -180,6 +182,7 @@ pub fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     roles: &[Role],
+    l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
     if roles[i] != Role::Interior {
@@ -192,7 +195,7 @@ pub fn laplacian_correction<const D: usize>(
             c[d] += cl * rij[d];
         }
     });
-    match gradient_correction(nb, p, i) {
+    match l {
         Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[b][a] * c[b]).sum()),
         None => c,
     }

@@ -9,7 +9,7 @@ use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::{self, fill, fill_vector};
 use crate::scene::{Aabb, Scene};
-use crate::sph::{self, Neighbours};
+use crate::sph::{self, Correction, Neighbours};
 use rayon::prelude::*;
 
 /// Viscous time-step limit Δt ≤ C_ν h²/ν.
@@ -82,6 +82,8 @@ struct Workspace<const D: usize> {
     roles: Vec<Role>,
     full_support: Vec<bool>,
     u_star: [Vec<f64>; D],
+    /// Kernel gradient correction L_i of each particle, Eq. (25).
+    corrections: Vec<Correction<D>>,
     /// Smagorinsky eddy viscosity ν_t.
     eddy: Vec<f64>,
     /// ĉ_i of the consistent Laplacian.
@@ -106,6 +108,7 @@ impl<const D: usize> Default for Workspace<D> {
             correction: components(),
             consistency: components(),
             eddy: Vec::new(),
+            corrections: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
             bicgstab: BiCgStab::default(),
@@ -280,11 +283,21 @@ impl<const D: usize> Simulation<D> {
         );
         ppe::full_support(&nb, &w.roles, &mut w.full_support);
 
+        // Kernel gradient correction L_i, Eq. (25), once per step for every operator below.
+        w.corrections.resize(p.len(), None);
+        fill(&mut w.corrections, |i| match p.kind[i] {
+            Kind::Fluid => sph::gradient_correction(&nb, p, i),
+            Kind::Wall => None,
+        });
+        let corrections = &w.corrections;
+
         // Smagorinsky eddy viscosity, Eq. (3)–(4).
         w.eddy.resize(p.len(), 0.0);
         let cs_delta = SMAGORINSKY * self.spacing;
         fill(&mut w.eddy, |i| match p.kind[i] {
-            Kind::Fluid if cs_delta > 0.0 => sph::eddy_viscosity(&nb, p, cs_delta, i),
+            Kind::Fluid if cs_delta > 0.0 => {
+                sph::eddy_viscosity(&nb, p, &corrections[i], cs_delta, i)
+            }
             _ => 0.0,
         });
 
@@ -303,6 +316,7 @@ impl<const D: usize> Simulation<D> {
             p,
             &w.roles,
             &w.full_support,
+            corrections,
             &w.u_star,
             dt,
             self.alpha,
@@ -311,7 +325,7 @@ impl<const D: usize> Simulation<D> {
         );
         w.pressure.clone_from(&p.pressure);
         fill_vector(&mut w.consistency, |i| {
-            ppe::laplacian_correction(&nb, p, &w.roles, i)
+            ppe::laplacian_correction(&nb, p, &w.roles, &corrections[i], i)
         });
         let op = PressureOperator {
             nb: &nb,
@@ -332,14 +346,18 @@ impl<const D: usize> Simulation<D> {
         // interior fluid around them; with no interior neighbour (splashes, the tip of a
         // surge) their own corrected gradient, in which only walls have pressure.
         fill_vector(&mut w.correction, |i| match w.roles[i] {
-            Role::Interior => sph::pressure_acceleration(&nb, p, i).map(|a| dt * a),
+            Role::Interior => {
+                sph::pressure_acceleration(&nb, p, &corrections[i], i).map(|a| dt * a)
+            }
             _ => [0.0; D],
         });
         let mut vel = std::mem::replace(&mut p.vel, components());
         fill_vector(&mut vel, |i| {
             let correction: [f64; D] = match w.roles[i] {
                 Role::Surface => sph::interior_average(&nb, p, &w.roles, &w.correction, i)
-                    .unwrap_or_else(|| sph::pressure_acceleration(&nb, p, i).map(|a| dt * a)),
+                    .unwrap_or_else(|| {
+                        sph::pressure_acceleration(&nb, p, &corrections[i], i).map(|a| dt * a)
+                    }),
                 _ => std::array::from_fn(|d| w.correction[d][i]),
             };
             match p.kind[i] {

@@ -102,10 +102,10 @@ pub fn viscous_acceleration<const D: usize>(
 pub fn eddy_viscosity<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    l: &Correction<D>,
     cs_delta: f64,
     i: usize,
 ) -> f64 {
-    let l = gradient_correction(nb, p, i);
     let mut g = [[0.0; D]; D];
     nb.for_each(i, |j, rij, r| {
         let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
@@ -122,7 +122,7 @@ pub fn eddy_viscosity<const D: usize>(
     });
     // Corrected ∂u_a/∂x_b = Σ_c L_bc g[c][a].
     let grad: [[f64; D]; D] = std::array::from_fn(|b| {
-        std::array::from_fn(|a| match &l {
+        std::array::from_fn(|a| match l {
             Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
             None => g[b][a],
         })
@@ -148,7 +148,7 @@ pub fn gradient_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     i: usize,
-) -> Option<[[f64; D]; D]> {
+) -> Correction<D> {
     let mut m = [[0.0; D]; D];
     nb.for_each(i, |j, rij, r| {
         let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
@@ -197,9 +197,12 @@ pub fn invert<const D: usize>(mut m: [[f64; D]; D]) -> Option<([[f64; D]; D], f6
     Some((inv, det))
 }
 
+/// L_i of Eq. (25), or None where the correction is not applied.
+pub type Correction<const D: usize> = Option<[[f64; D]; D]>;
+
 /// Applies L_i to a vector (identity where the correction is off).
 #[inline]
-pub fn apply_correction<const D: usize>(l: &Option<[[f64; D]; D]>, v: [f64; D]) -> [f64; D] {
+pub fn apply_correction<const D: usize>(l: &Correction<D>, v: [f64; D]) -> [f64; D] {
     match l {
         Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[a][b] * v[b]).sum()),
         None => v,
@@ -212,7 +215,7 @@ pub fn gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     phi: &[f64],
-    l: &Option<[[f64; D]; D]>,
+    l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
     let mut grad = [0.0; D];
@@ -231,10 +234,10 @@ pub fn gradient<const D: usize>(
 pub fn pressure_acceleration<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    let l = gradient_correction(nb, p, i);
-    gradient(nb, p, &p.pressure, &l, i).map(|g| g / p.density[i])
+    gradient(nb, p, &p.pressure, l, i).map(|g| g / p.density[i])
 }
 
 /// Kernel average Σ_j W_ij f_j / Σ_j W_ij of a vector field over the interior fluid
