@@ -7,7 +7,7 @@
 //!   pressure carried hydrostatically to the wall particle, as in Adami et al. 2012);
 //! * walls with no fluid in reach: P_w = 0.
 //!
-//! After the solve, negative pressures are clipped to zero (see `clip_tension`).
+//! After the solve, negative fluid pressures are clipped to zero (see `clip_tension`).
 //!
 //! The wall rows make the system non-symmetric, hence BiCGSTAB.
 
@@ -133,7 +133,7 @@ fn interior_source<const D: usize>(
     // grad_u[b][a] = Σ_j V_j (u_j − u_i)_a ∂_b W_ij, uncorrected.
     let mut grad_u = [[0.0; D]; D];
     nb.for_each(i, |j, rij, r| {
-        let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
+        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
         let uj: [f64; D] = std::array::from_fn(|a| {
             if p.kind[j] == Kind::Wall {
                 wall_u[a]
@@ -164,11 +164,16 @@ fn interior_source<const D: usize>(
     -(rho0 / dt * div + density_term)
 }
 
-/// Clips negative pressures to zero after the solve, as SPlisHSPlasH's implicit solvers do:
-/// tension pulls particles into clumps, and the hydrostatic extrapolation would give the wall
-/// particles above the free surface a suction that glues the fluid to the wall.
-pub fn clip_tension(pressure: &mut [f64]) {
-    pressure.iter_mut().for_each(|x| *x = x.max(0.0));
+/// Clips negative fluid pressures to zero after the solve, as SPlisHSPlasH's implicit solvers
+/// do: tension would pull particles into clumps. Wall pressures are kept as solved: above the
+/// free surface the hydrostatic extrapolation is negative, and only with the values the solve
+/// used does the corrector keep a still surface at rest where it meets a wall.
+pub fn clip_tension(pressure: &mut [f64], kind: &[Kind]) {
+    for (pressure, kind) in pressure.iter_mut().zip(kind) {
+        if *kind == Kind::Fluid {
+            *pressure = pressure.max(0.0);
+        }
+    }
 }
 
 /// First-order consistency of the Laplacian of Eq. (27). Where the free surface truncates the
@@ -190,7 +195,7 @@ pub fn laplacian_correction<const D: usize>(
     }
     let mut c = [0.0; D];
     nb.for_each(i, |j, rij, r| {
-        let cl = 2.0 * p.mass[j] / p.density[i] * nb.laplacian_factor(r);
+        let cl = 2.0 * p.mass[j] / p.rest_density[i] * nb.laplacian_factor(r);
         for d in 0..D {
             c[d] += cl * rij[d];
         }
@@ -217,7 +222,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         let (nb, p) = (self.nb, self.p);
         let c_dot_r: f64 = (0..D).map(|d| self.consistency[d][i] * rij[d]).sum();
         laplacian_coefficient(nb, p, i, j, r)
-            - p.mass[j] / p.density[j] * nb.kernel.grad_factor(r) * c_dot_r
+            - p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * c_dot_r
     }
 
     /// (A x)_i.

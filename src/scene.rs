@@ -87,7 +87,7 @@ pub struct SolverSettings {
     pub cfl: f64,
     /// Smoothing length over particle spacing, h/dx.
     pub h_over_dx: f64,
-    /// Free-surface threshold on ∇·r (default 1.5 in 2D, 2.4 in 3D).
+    /// Free-surface threshold on ∇·r (default 1.65 in 2D, 2.55 in 3D).
     pub free_surface_threshold: Option<f64>,
 }
 
@@ -172,7 +172,7 @@ impl Scene {
     pub fn free_surface_threshold(&self) -> f64 {
         self.solver
             .free_surface_threshold
-            .unwrap_or(if self.dimensions == 2 { 1.5 } else { 2.4 })
+            .unwrap_or(if self.dimensions == 2 { 1.65 } else { 2.55 })
     }
 
     /// Smoothing length h.

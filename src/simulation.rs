@@ -338,7 +338,7 @@ impl<const D: usize> Simulation<D> {
             .solve(&op, &w.rhs, &mut w.pressure, self.solver)
             .map_err(|source| NumericalFailure::Solver { step, time, source })?;
         std::mem::swap(&mut p.pressure, &mut w.pressure);
-        ppe::clip_tension(&mut p.pressure);
+        ppe::clip_tension(&mut p.pressure, &p.kind);
 
         // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ)∇Pⁿ⁺¹. Free-surface particles sit on the
         // Dirichlet boundary, where a one-sided gradient is unreliable (it makes them sink or

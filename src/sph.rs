@@ -79,7 +79,7 @@ pub fn viscous_acceleration<const D: usize>(
     eddy: &[f64],
     i: usize,
 ) -> [f64; D] {
-    let (rho_i, nu_i) = (p.density[i], p.viscosity[i] + eddy[i]);
+    let (rho_i, nu_i) = (p.rest_density[i], p.viscosity[i] + eddy[i]);
     let mut acc = [0.0; D];
     nb.for_each(i, |j, _, r| {
         let nu_j = if p.kind[j] == Kind::Wall {
@@ -87,7 +87,7 @@ pub fn viscous_acceleration<const D: usize>(
         } else {
             p.viscosity[j] + eddy[j]
         };
-        let rho_j = p.density[j];
+        let rho_j = p.rest_density[j];
         let c =
             p.mass[j] * (rho_i * nu_i + rho_j * nu_j) / (rho_i * rho_j) * nb.laplacian_factor(r);
         for d in 0..D {
@@ -108,7 +108,7 @@ pub fn eddy_viscosity<const D: usize>(
 ) -> f64 {
     let mut g = [[0.0; D]; D];
     nb.for_each(i, |j, rij, r| {
-        let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
+        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
         for a in 0..D {
             let du = if p.kind[j] == Kind::Wall {
                 0.0
@@ -151,7 +151,7 @@ pub fn gradient_correction<const D: usize>(
 ) -> Correction<D> {
     let mut m = [[0.0; D]; D];
     nb.for_each(i, |j, rij, r| {
-        let vf = p.mass[j] / p.density[j] * nb.kernel.grad_factor(r);
+        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
         for a in 0..D {
             for b in 0..D {
                 m[a][b] -= vf * rij[a] * rij[b];
@@ -220,7 +220,7 @@ pub fn gradient<const D: usize>(
 ) -> [f64; D] {
     let mut grad = [0.0; D];
     nb.for_each(i, |j, rij, r| {
-        let c = p.mass[j] / p.density[j] * (phi[j] - phi[i]) * nb.kernel.grad_factor(r);
+        let c = p.mass[j] / p.rest_density[j] * (phi[j] - phi[i]) * nb.kernel.grad_factor(r);
         for d in 0..D {
             grad[d] += c * rij[d];
         }
@@ -237,7 +237,7 @@ pub fn pressure_acceleration<const D: usize>(
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    gradient(nb, p, &p.pressure, l, i).map(|g| g / p.density[i])
+    gradient(nb, p, &p.pressure, l, i).map(|g| g / p.rest_density[i])
 }
 
 /// Kernel average Σ_j W_ij f_j / Σ_j W_ij of a vector field over the interior fluid
@@ -288,5 +288,5 @@ pub fn laplacian_coefficient<const D: usize>(
     j: usize,
     r: f64,
 ) -> f64 {
-    -2.0 * p.mass[j] / p.density[i] * nb.laplacian_factor(r)
+    -2.0 * p.mass[j] / p.rest_density[i] * nb.laplacian_factor(r)
 }
