@@ -88,8 +88,8 @@ struct Workspace<const D: usize> {
     eddy: Vec<f64>,
     /// ĉ_i of the consistent Laplacian.
     consistency: [Vec<f64>; D],
-    /// Velocity correction Δt ∇P/ρ of the corrector.
-    correction: [Vec<f64>; D],
+    /// Shifting displacement δr of each particle.
+    shift: [Vec<f64>; D],
     rhs: Vec<f64>,
     pressure: Vec<f64>,
     bicgstab: BiCgStab,
@@ -105,7 +105,7 @@ impl<const D: usize> Default for Workspace<D> {
             roles: Vec::new(),
             full_support: Vec::new(),
             u_star: components(),
-            correction: components(),
+            shift: components(),
             consistency: components(),
             eddy: Vec::new(),
             corrections: Vec::new(),
@@ -259,7 +259,7 @@ impl<const D: usize> Simulation<D> {
             .density_divr
             .iter_mut()
             .chain(&mut w.u_star)
-            .chain(&mut w.correction)
+            .chain(&mut w.shift)
             .chain(&mut w.consistency)
         {
             a.resize(p.len(), 0.0);
@@ -340,30 +340,15 @@ impl<const D: usize> Simulation<D> {
         std::mem::swap(&mut p.pressure, &mut w.pressure);
         ppe::clip_tension(&mut p.pressure, &p.kind);
 
-        // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ)∇Pⁿ⁺¹. Free-surface particles sit on the
-        // Dirichlet boundary, where a one-sided gradient is unreliable (it makes them sink or
-        // bounce off the fluid): they take the kernel average of the correction of the
-        // interior fluid around them; with no interior neighbour (splashes, the tip of a
-        // surge) their own corrected gradient, in which only walls have pressure.
-        fill_vector(&mut w.correction, |i| match w.roles[i] {
-            Role::Interior => {
-                sph::pressure_acceleration(&nb, p, &corrections[i], i).map(|a| dt * a)
-            }
-            _ => [0.0; D],
-        });
+        // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient, for every
+        // fluid particle (at the free surface too, where P = 0 and walls push back).
         let mut vel = std::mem::replace(&mut p.vel, components());
-        fill_vector(&mut vel, |i| {
-            let correction: [f64; D] = match w.roles[i] {
-                Role::Surface => sph::interior_average(&nb, p, &w.roles, &w.correction, i)
-                    .unwrap_or_else(|| {
-                        sph::pressure_acceleration(&nb, p, &corrections[i], i).map(|a| dt * a)
-                    }),
-                _ => std::array::from_fn(|d| w.correction[d][i]),
-            };
-            match p.kind[i] {
-                Kind::Fluid => std::array::from_fn(|d| w.u_star[d][i] - correction[d]),
-                Kind::Wall => [0.0; D],
+        fill_vector(&mut vel, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let a = sph::pressure_acceleration(&nb, p, &corrections[i], i);
+                std::array::from_fn(|d| w.u_star[d][i] - dt * a[d])
             }
+            Kind::Wall => [0.0; D],
         });
         p.vel = vel;
 
@@ -387,7 +372,7 @@ impl<const D: usize> Simulation<D> {
         // where ∇C points out of the fluid, unless the particle is compressed.
         let h = kernel.h();
         let full = &w.full_support;
-        fill_vector(&mut w.correction, |i| {
+        fill_vector(&mut w.shift, |i| {
             // Near the free surface ∇C points out of the fluid because the kernel is truncated;
             // there only compressed particles (clumps) are shifted.
             if full[i] || (p.is_fluid(i) && p.density[i] > p.rest_density[i]) {
@@ -400,7 +385,7 @@ impl<const D: usize> Simulation<D> {
             }
         });
         for d in 0..D {
-            let (kind, shift) = (&p.kind, &w.correction[d]);
+            let (kind, shift) = (&p.kind, &w.shift[d]);
             p.pos[d]
                 .par_iter_mut()
                 .zip(&p.vel[d])

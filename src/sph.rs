@@ -4,7 +4,6 @@
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::particles::{Kind, Particles};
-use crate::ppe::Role;
 
 /// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
 const ETA2_IN_H2: f64 = 1.0e-4;
@@ -238,28 +237,6 @@ pub fn pressure_acceleration<const D: usize>(
     i: usize,
 ) -> [f64; D] {
     gradient(nb, p, &p.pressure, l, i).map(|g| g / p.rest_density[i])
-}
-
-/// Kernel average Σ_j W_ij f_j / Σ_j W_ij of a vector field over the interior fluid
-/// neighbours of i, or None when i has none.
-pub fn interior_average<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    roles: &[Role],
-    f: &[Vec<f64>; D],
-    i: usize,
-) -> Option<[f64; D]> {
-    let (mut wsum, mut sum) = (0.0, [0.0; D]);
-    nb.for_each(i, |j, _, r| {
-        if roles[j] == Role::Interior && p.is_fluid(j) {
-            let w = nb.kernel.w(r);
-            wsum += w;
-            for d in 0..D {
-                sum[d] += w * f[d][j];
-            }
-        }
-    });
-    (wsum > 0.0).then(|| sum.map(|s| s / wsum))
 }
 
 /// Gradient of the particle concentration ∇C_i = Σ_j V_j ∇W_ij, V_j = m_j/ρ0_j (Eq. 10).

@@ -1,4 +1,4 @@
-//! Hydrostatic tank (2D): the settled pressure against ρ g (H − y).
+//! Hydrostatic tank (2D): the pressure against ρ g (H − y) after 1 s, and water that stays still.
 
 use crate::common::{read_frame, run_scene, shipped_scene, stats_column, TempDir};
 
@@ -6,7 +6,7 @@ use crate::common::{read_frame, run_scene, shipped_scene, stats_column, TempDir}
 fn still_water_has_hydrostatic_pressure_and_no_penetration() {
     let scene = shipped_scene("hydrostatic_2d.toml");
     let dir = TempDir::new("hydrostatic");
-    let summary = run_scene(&scene, dir.path(), 0.4);
+    let summary = run_scene(&scene, dir.path(), 1.0);
     let last = summary.frames.len() - 1;
     let (rho, g) = (scene.fluids[0].density, -scene.gravity[1]);
     let depth = scene.blocks[0].region.max[1];
