@@ -53,17 +53,26 @@ impl Plan {
                 bytes_per_particle: f64s(2) + 2,
             },
             Stage {
+                name: "kernel correction",
+                what: "L_i of Eq. (25) once per step, shared by every corrected operator",
+                bytes_per_particle: f64s(d * d + 1),
+            },
+            Stage {
                 name: "predictor",
-                what: "Eq. (5): u* = u + Δt (ν∇²u (Eq. 26) + g)",
-                bytes_per_particle: f64s(d),
+                what: "Eq. (5): u* = u + Δt (∇·((ν + ν_t)∇u) (Eq. 26, Smagorinsky ν_t Eq. 3–4) + g)",
+                bytes_per_particle: f64s(d + 1),
             },
             Stage {
                 name: "pressure Poisson equation",
-                what: "Eq. (6) source, Eq. (27) Laplacian matrix-free in BiCGSTAB + Jacobi, warm start; walls: Neumann extrapolation",
-                bytes_per_particle: f64s(2) + BiCgStab::BYTES_PER_UNKNOWN,
+                what: "Eq. (6) source, Eq. (27) Laplacian (first-order consistent) matrix-free in BiCGSTAB + Jacobi, warm start; walls: Neumann extrapolation",
+                bytes_per_particle: f64s(2 + d) + BiCgStab::BYTES_PER_UNKNOWN,
             },
-            Stage { name: "corrector", what: "Eq. (7) with the pressure gradient of Eq. (23)", bytes_per_particle: 0 },
-            Stage { name: "advection", what: "Eq. (8): r += Δt u", bytes_per_particle: 0 },
+            Stage { name: "corrector", what: "Eq. (7) with the corrected gradient (Eq. 20, 24–25)", bytes_per_particle: 0 },
+            Stage {
+                name: "advection + shifting",
+                what: "Eq. (8): r += Δt u, then Fickian shifting δr = −D∇C (Eq. 9–10)",
+                bytes_per_particle: f64s(d),
+            },
             Stage {
                 name: "diagnostics",
                 what: "max speed, kinetic energy, density error, penetrations → stats.csv",
