@@ -17,6 +17,8 @@ pub const NO_FLUID: u16 = u16::MAX;
 pub struct Particles<const D: usize> {
     pub pos: [Vec<f64>; D],
     pub vel: [Vec<f64>; D],
+    /// Acceleration of the last step (fluid; walls are at rest).
+    pub acceleration: [Vec<f64>; D],
     pub pressure: Vec<f64>,
     /// Summation density ρ_i = Σ_j m_j W_ij (fluid); the rest density for walls.
     pub density: Vec<f64>,
@@ -51,6 +53,7 @@ impl<const D: usize> Default for Particles<D> {
         Self {
             pos: components(),
             vel: components(),
+            acceleration: components(),
             pressure: Vec::new(),
             density: Vec::new(),
             mass: Vec::new(),
@@ -77,6 +80,7 @@ impl<const D: usize> Particles<D> {
         for d in 0..D {
             self.pos[d].push(p.pos[d]);
             self.vel[d].push(0.0);
+            self.acceleration[d].push(0.0);
         }
         self.id.push(self.id.len() as u64);
         self.pressure.push(0.0);

@@ -97,13 +97,19 @@ pub fn source<const D: usize>(
     fill(b, |i| match roles[i] {
         Role::Interior => interior_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i),
         Role::Wall => {
+            // ρ (g − a_f)·(r_w − r_f): the fluid's own momentum balance ∇P = ρ (g − a), with
+            // the acceleration of the last step; for still water the hydrostatic term. Along a
+            // wall where the fluid falls freely it vanishes, so dry wall above a falling
+            // surface does not suck the fluid in.
             let (mut wsum, mut hydro) = (0.0, 0.0);
             nb.for_each(i, |j, rij, r| {
                 if p.is_fluid(j) {
                     let w = nb.kernel.w(r);
-                    let g_dot_r: f64 = (0..D).map(|d| gravity[d] * rij[d]).sum();
+                    let f_dot_r: f64 = (0..D)
+                        .map(|d| (gravity[d] - p.acceleration[d][j]) * rij[d])
+                        .sum();
                     wsum += w;
-                    hydro += w * p.rest_density[j] * g_dot_r;
+                    hydro += w * p.rest_density[j] * f_dot_r;
                 }
             });
             hydro / wsum

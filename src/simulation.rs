@@ -341,16 +341,24 @@ impl<const D: usize> Simulation<D> {
         ppe::clip_tension(&mut p.pressure, &p.kind);
 
         // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient, for every
-        // fluid particle (at the free surface too, where P = 0 and walls push back).
-        let mut vel = std::mem::replace(&mut p.vel, components());
-        fill_vector(&mut vel, |i| match p.kind[i] {
+        // fluid particle (at the free surface too, where P = 0 and walls push back). The
+        // step's acceleration (uⁿ⁺¹ − uⁿ)/Δt is kept for the wall pressure of the next step.
+        let mut acceleration = std::mem::replace(&mut p.acceleration, components());
+        fill_vector(&mut acceleration, |i| match p.kind[i] {
             Kind::Fluid => {
                 let a = sph::pressure_acceleration(&nb, p, &corrections[i], i);
-                std::array::from_fn(|d| w.u_star[d][i] - dt * a[d])
+                std::array::from_fn(|d| (w.u_star[d][i] - p.vel[d][i]) / dt - a[d])
             }
             Kind::Wall => [0.0; D],
         });
-        p.vel = vel;
+        p.acceleration = acceleration;
+        for d in 0..D {
+            let a = &p.acceleration[d];
+            p.vel[d]
+                .par_iter_mut()
+                .zip(a)
+                .for_each(|(v, a)| *v += dt * a);
+        }
 
         // Density error where the summation density is not truncated by the free surface.
         let full = &w.full_support;
