@@ -42,7 +42,9 @@ pub fn assign_roles<const D: usize>(
 ) {
     roles.resize(p.len(), Role::Idle);
     fill(roles, |i| match p.kind[i] {
-        Kind::Fluid if div_r[i] < threshold => Role::Surface,
+        // ∇·r barely sees near-coincident neighbours, so a particle squeezed against a wall or
+        // into a clump can look like free surface; one denser than rest never is.
+        Kind::Fluid if div_r[i] < threshold && p.density[i] < p.rest_density[i] => Role::Surface,
         Kind::Fluid => Role::Interior,
         Kind::Wall => {
             let mut near_fluid = false;
@@ -91,22 +93,27 @@ pub fn source<const D: usize>(
     dt: f64,
     alpha: f64,
     gravity: [f64; D],
+    wall_normal: impl Fn([f64; D]) -> [f64; D] + Sync,
     b: &mut Vec<f64>,
 ) {
     b.resize(p.len(), 0.0);
     fill(b, |i| match roles[i] {
         Role::Interior => interior_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i),
         Role::Wall => {
-            // ρ (g − a_f)·(r_w − r_f): the fluid's own momentum balance ∇P = ρ (g − a), with
-            // the acceleration of the last step; for still water the hydrostatic term. Along a
-            // wall where the fluid falls freely it vanishes, so dry wall above a falling
-            // surface does not suck the fluid in.
+            // ρ (g − a_t)·(r_w − r_f): the fluid's momentum balance ∇P = ρ (g − a) with a_t the
+            // tangential part (along the wall, normal n) of the fluid's acceleration in the last
+            // step; the wall itself does not accelerate (Adami et al. 2012). For still water the
+            // hydrostatic term; along a wall where the fluid falls freely it vanishes, so dry
+            // wall above a falling surface does not suck the fluid in.
+            let n = wall_normal(p.position(i));
             let (mut wsum, mut hydro) = (0.0, 0.0);
             nb.for_each(i, |j, rij, r| {
                 if p.is_fluid(j) {
                     let w = nb.kernel.w(r);
+                    let a: [f64; D] = std::array::from_fn(|d| p.acceleration[d][j]);
+                    let a_n: f64 = (0..D).map(|d| a[d] * n[d]).sum();
                     let f_dot_r: f64 = (0..D)
-                        .map(|d| (gravity[d] - p.acceleration[d][j]) * rij[d])
+                        .map(|d| (gravity[d] - (a[d] - a_n * n[d])) * rij[d])
                         .sum();
                     wsum += w;
                     hydro += w * p.rest_density[j] * f_dot_r;
@@ -161,12 +168,14 @@ fn interior_source<const D: usize>(
         None => (0..D).map(|a| grad_u[a][a]).sum(),
     };
     let rho0 = p.rest_density[i];
-    // The density term only where the summation density is not truncated by the surface.
-    let density_term = if full_support {
-        alpha * (rho0 - rho_i) / (dt * dt)
+    // Where the free surface truncates the kernel the summation density is low because
+    // neighbours are missing, not because the fluid expanded: there only compression counts.
+    let density_deviation = if full_support {
+        rho0 - rho_i
     } else {
-        0.0
+        (rho0 - rho_i).min(0.0)
     };
+    let density_term = alpha * density_deviation / (dt * dt);
     -(rho0 / dt * div + density_term)
 }
 

@@ -321,6 +321,7 @@ impl<const D: usize> Simulation<D> {
             dt,
             self.alpha,
             gravity,
+            |x| wall_normal(&self.container, &self.obstacles, x),
             &mut w.rhs,
         );
         w.pressure.clone_from(&p.pressure);
@@ -456,6 +457,30 @@ impl<const D: usize> Simulation<D> {
             outside || self.obstacles.iter().any(|o| o.contains(&x))
         })
     }
+}
+
+/// Unit normal of the wall at wall particle position x, pointing into the fluid: towards the
+/// container for container walls, out of the nearest face for obstacle particles.
+fn wall_normal<const D: usize>(container: &Aabb, obstacles: &[Aabb], x: [f64; D]) -> [f64; D] {
+    let to_box: [f64; D] =
+        std::array::from_fn(|d| x[d].clamp(container.min[d], container.max[d]) - x[d]);
+    let len = to_box.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if len > 0.0 {
+        return to_box.map(|v| v / len);
+    }
+    let mut best = (f64::INFINITY, [0.0; D]);
+    for o in obstacles {
+        for d in 0..D {
+            for (gap, sign) in [(x[d] - o.min[d], -1.0), (o.max[d] - x[d], 1.0)] {
+                if gap.abs() < best.0 {
+                    let mut n = [0.0; D];
+                    n[d] = sign;
+                    best = (gap.abs(), n);
+                }
+            }
+        }
+    }
+    best.1
 }
 
 fn speed<const D: usize>(p: &Particles<D>, i: usize) -> f64 {
