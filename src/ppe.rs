@@ -115,8 +115,17 @@ pub fn source<const D: usize>(
                     let f_dot_r: f64 = (0..D)
                         .map(|d| (gravity[d] - (a[d] - a_n * n[d])) * rij[d])
                         .sum();
+                    // A free-surface particle has no PPE row, so the wall's kinematic condition
+                    // ∂P/∂n = (ρ/Δt) uⁿ·n for flow into the wall enters through the wall row.
+                    let approach = if roles[j] == Role::Surface {
+                        let u_n: f64 = (0..D).map(|d| p.vel[d][j] * n[d]).sum();
+                        let r_n: f64 = (0..D).map(|d| rij[d] * n[d]).sum();
+                        u_n.min(0.0) / dt * r_n
+                    } else {
+                        0.0
+                    };
                     wsum += w;
-                    hydro += w * p.rest_density[j] * f_dot_r;
+                    hydro += w * p.rest_density[j] * (f_dot_r + approach);
                 }
             });
             hydro / wsum

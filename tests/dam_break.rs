@@ -14,7 +14,7 @@ const MARTIN_MOYCE: [(f64, f64); 6] = [
 ];
 
 #[test]
-#[ignore = "known failure: the 2D dam break stops at t ≈ 0.11 s when particles at the surge tip cross the floor (see the issue note)"]
+#[ignore = "known failure: the 2D dam break stops at t ≈ 0.13 s when bottom particles squeezed against the floor cross it (see the issue note)"]
 fn surge_front_follows_martin_and_moyce() {
     let mut scene = shipped_scene("dam_break_2d.toml");
     let a = scene.blocks[0].region.max[0];
