@@ -1,10 +1,13 @@
 //! The pressure Poisson equation of Eq. (6), assembled matrix-free:
 //!
-//! * interior fluid rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt²  with the Laplacian of Eq. (27);
+//! * interior fluid rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt²  with the Laplacian of
+//!   Eq. (27), made first-order consistent where the free surface truncates the kernel;
 //! * free-surface rows:    P_i = 0 (Dirichlet);
-//! * wall rows:            P_w = Σ_f ω_wf (P_f + ρ_f g·(r_w − r_f)), ω_wf = W_wf/Σ_f W_wf, the
-//!   discrete Neumann condition ∂P/∂n = ρ g·n (the wall pressure is the kernel-weighted fluid
-//!   pressure carried hydrostatically to the wall particle, as in Adami et al. 2012);
+//! * wall rows:            P_w = Σ_f ω_wf (P_f + ρ_f (g − a_t,f)·(r_w − r_f)), ω_wf = W_wf/Σ_f W_wf,
+//!   the discrete Neumann condition (the kernel-weighted fluid pressure carried to the wall
+//!   particle by the fluid's momentum balance, after Adami et al. 2012; a_t is the fluid's
+//!   acceleration along the wall), plus the kinematic term for free-surface particles moving
+//!   into the wall;
 //! * walls with no fluid in reach: P_w = 0.
 //!
 //! After the solve, negative fluid pressures are clipped to zero (see `clip_tension`).
