@@ -17,7 +17,7 @@
 use crate::linsolve::LinearOperator;
 use crate::particles::{Kind, Particles};
 use crate::reduce::fill;
-use crate::sph::{laplacian_coefficient, Correction, Neighbours};
+use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Neighbours};
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -153,32 +153,17 @@ fn interior_source<const D: usize>(
 ) -> f64 {
     let rho_i = p.density[i];
     // Walls take the fluid's own predictor increment u*_i − uⁿ_i: the body force is carried by
-    // the hydrostatic term of the wall rows, the wall's kinematic condition by the divergence.
+    // the wall rows, the wall's kinematic condition by the divergence.
     let wall_u: [f64; D] = std::array::from_fn(|d| u_star[d][i] - p.vel[d][i]);
-    // grad_u[b][a] = Σ_j V_j (u_j − u_i)_a ∂_b W_ij, uncorrected.
-    let mut grad_u = [[0.0; D]; D];
-    nb.for_each(i, |j, rij, r| {
-        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
-        let uj: [f64; D] = std::array::from_fn(|a| {
-            if p.kind[j] == Kind::Wall {
-                wall_u[a]
-            } else {
-                u_star[a][j]
-            }
-        });
-        for b in 0..D {
-            for a in 0..D {
-                grad_u[b][a] += vf * (uj[a] - u_star[a][i]) * rij[b];
-            }
+    let velocity = |j: usize| -> [f64; D] {
+        match p.kind[j] {
+            Kind::Wall => wall_u,
+            Kind::Fluid => std::array::from_fn(|d| u_star[d][j]),
         }
-    });
-    // ∇·u = trace(L ∇u), Eq. (22) with Eq. (24)–(25).
-    let div: f64 = match l {
-        Some(l) => (0..D)
-            .map(|a| (0..D).map(|b| l[a][b] * grad_u[b][a]).sum::<f64>())
-            .sum(),
-        None => (0..D).map(|a| grad_u[a][a]).sum(),
     };
+    // ∇·u* = trace of the corrected velocity gradient, Eq. (22) with Eq. (24)–(25).
+    let grad_u = velocity_gradient(nb, p, l, velocity, i);
+    let div: f64 = (0..D).map(|a| grad_u[a][a]).sum();
     let rho0 = p.rest_density[i];
     // Where the free surface truncates the kernel the summation density is low because
     // neighbours are missing, not because the fluid expanded: there only compression counts.

@@ -301,7 +301,7 @@ impl<const D: usize> Simulation<D> {
             _ => 0.0,
         });
 
-        // Predictor, Eq. (5): u* = uⁿ + Δt (ν∇²uⁿ + g); walls stay at rest.
+        // Predictor, Eq. (5): u* = uⁿ + Δt (∇·((ν + ν_t)∇uⁿ) + g); walls stay at rest.
         fill_vector(&mut w.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
                 let visc = sph::viscous_acceleration(&nb, p, &w.eddy, i);
@@ -377,13 +377,11 @@ impl<const D: usize> Simulation<D> {
         };
 
         // Advection, Eq. (8), with Fickian shifting δr = −D ∇C (Eq. 10), D = A h |u| Δt
-        // (Skillen et al. 2013), each component capped at 0.1 dx; not at the free surface,
-        // where ∇C points out of the fluid, unless the particle is compressed.
+        // (Skillen et al. 2013), each component capped at 0.1 dx. Near the free surface ∇C
+        // points out of the fluid because the kernel is truncated; there only compressed
+        // particles (clumps) are shifted.
         let h = kernel.h();
-        let full = &w.full_support;
         fill_vector(&mut w.shift, |i| {
-            // Near the free surface ∇C points out of the fluid because the kernel is truncated;
-            // there only compressed particles (clumps) are shifted.
             if full[i] || (p.is_fluid(i) && p.density[i] > p.rest_density[i]) {
                 let u = speed(p, i);
                 let grad_c = sph::concentration_gradient(&nb, p, i);

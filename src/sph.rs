@@ -96,6 +96,35 @@ pub fn viscous_acceleration<const D: usize>(
     acc
 }
 
+/// Corrected gradient of a velocity field, G[b][a] = ∂u_a/∂x_b = Σ_c L_bc Σ_j V_j (u_j − u_i)_a ∂_c W_ij
+/// (Eq. 20 with Eq. 24–25), with `u(j)` the velocity taken for particle j.
+pub fn velocity_gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Correction<D>,
+    u: impl Fn(usize) -> [f64; D],
+    i: usize,
+) -> [[f64; D]; D] {
+    let ui = u(i);
+    let mut g = [[0.0; D]; D];
+    nb.for_each(i, |j, rij, r| {
+        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
+        let uj = u(j);
+        for a in 0..D {
+            let du = uj[a] - ui[a];
+            for b in 0..D {
+                g[b][a] += vf * du * rij[b];
+            }
+        }
+    });
+    std::array::from_fn(|b| {
+        std::array::from_fn(|a| match l {
+            Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
+            None => g[b][a],
+        })
+    })
+}
+
 /// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S|, |S| = (2 S_ab S_ab)^½, S the strain rate of
 /// the corrected velocity gradient (Eq. 3–4); walls are at rest.
 pub fn eddy_viscosity<const D: usize>(
@@ -105,27 +134,13 @@ pub fn eddy_viscosity<const D: usize>(
     cs_delta: f64,
     i: usize,
 ) -> f64 {
-    let mut g = [[0.0; D]; D];
-    nb.for_each(i, |j, rij, r| {
-        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
-        for a in 0..D {
-            let du = if p.kind[j] == Kind::Wall {
-                0.0
-            } else {
-                p.vel[a][j]
-            } - p.vel[a][i];
-            for b in 0..D {
-                g[b][a] += vf * du * rij[b];
-            }
+    let velocity = |j: usize| -> [f64; D] {
+        match p.kind[j] {
+            Kind::Wall => [0.0; D],
+            Kind::Fluid => p.velocity(j),
         }
-    });
-    // Corrected ∂u_a/∂x_b = Σ_c L_bc g[c][a].
-    let grad: [[f64; D]; D] = std::array::from_fn(|b| {
-        std::array::from_fn(|a| match l {
-            Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
-            None => g[b][a],
-        })
-    });
+    };
+    let grad = velocity_gradient(nb, p, l, velocity, i);
     let mut ss = 0.0;
     for a in 0..D {
         for b in 0..D {
