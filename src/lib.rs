@@ -3,6 +3,7 @@
 //! A scene file becomes a [`scene::Scene`], whose particles ([`lattice`]) advance by the
 //! projection step of [`simulation::Simulation`]; [`run`] drives a whole run with its output.
 
+pub mod free_surface;
 pub mod grid;
 pub mod io;
 pub mod kernel;
@@ -15,5 +16,7 @@ pub mod progress;
 pub mod reduce;
 pub mod run;
 pub mod scene;
+pub mod shifting;
 pub mod simulation;
 pub mod sph;
+pub mod wall;

@@ -17,8 +17,6 @@ pub const NO_FLUID: u16 = u16::MAX;
 pub struct Particles<const D: usize> {
     pub pos: [Vec<f64>; D],
     pub vel: [Vec<f64>; D],
-    /// Acceleration of the last step (fluid; walls are at rest).
-    pub acceleration: [Vec<f64>; D],
     pub pressure: Vec<f64>,
     /// Summation density ρ_i = Σ_j m_j W_ij (fluid); the rest density for walls.
     pub density: Vec<f64>,
@@ -53,7 +51,6 @@ impl<const D: usize> Default for Particles<D> {
         Self {
             pos: components(),
             vel: components(),
-            acceleration: components(),
             pressure: Vec::new(),
             density: Vec::new(),
             mass: Vec::new(),
@@ -80,7 +77,6 @@ impl<const D: usize> Particles<D> {
         for d in 0..D {
             self.pos[d].push(p.pos[d]);
             self.vel[d].push(0.0);
-            self.acceleration[d].push(0.0);
         }
         self.id.push(self.id.len() as u64);
         self.pressure.push(0.0);
@@ -100,6 +96,16 @@ impl<const D: usize> Particles<D> {
     #[inline]
     pub fn velocity(&self, i: usize) -> [f64; D] {
         std::array::from_fn(|d| self.vel[d][i])
+    }
+
+    /// Velocity of particle i with the walls at rest (the no-slip value walls take in
+    /// velocity gradients).
+    #[inline]
+    pub fn velocity_no_slip(&self, i: usize) -> [f64; D] {
+        match self.kind[i] {
+            Kind::Fluid => self.velocity(i),
+            Kind::Wall => [0.0; D],
+        }
     }
 
     #[inline]

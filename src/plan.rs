@@ -1,11 +1,14 @@
 //! What a scene will run: the stages of a step in order, the particle counts, and the memory
 //! the arrays of those stages take.
 
+use crate::free_surface::Support;
 use crate::lattice;
 use crate::linsolve::BiCgStab;
 use crate::particles::Kind;
 use crate::scene::Scene;
+use crate::wall::WallFit;
 use std::fmt;
+use std::mem::size_of;
 
 /// One stage of the time step.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +39,11 @@ impl Plan {
         let fluid = kinds.iter().filter(|&&k| k == Kind::Fluid).count();
         let d = scene.dimensions;
         let f64s = |n: usize| 8 * n;
+        let (support, wall_fit) = if d == 2 {
+            (size_of::<Support<2>>(), size_of::<WallFit<2>>())
+        } else {
+            (size_of::<Support<3>>(), size_of::<WallFit<3>>())
+        };
         let stages = vec![
             Stage {
                 name: "particles",
@@ -49,8 +57,8 @@ impl Plan {
             },
             Stage {
                 name: "density + free surface",
-                what: "summation density, ∇·r < threshold ⇒ free surface (P = 0)",
-                bytes_per_particle: f64s(2) + 2,
+                what: "summation density; λ_min of the moment matrix, normal and scan region (Marrone et al. 2010) ⇒ free surface (P = 0)",
+                bytes_per_particle: f64s(1) + support + 2,
             },
             Stage {
                 name: "kernel correction",
@@ -64,13 +72,13 @@ impl Plan {
             },
             Stage {
                 name: "pressure Poisson equation",
-                what: "Eq. (6) source, Eq. (27) Laplacian (first-order consistent) matrix-free in BiCGSTAB + Jacobi, warm start; walls: Neumann extrapolation",
-                bytes_per_particle: f64s(2 + d) + BiCgStab::BYTES_PER_UNKNOWN,
+                what: "Eq. (6) source, Eq. (27) Laplacian (first-order consistent) matrix-free in BiCGSTAB + Jacobi, warm start; walls: Neumann condition through a linear fit along the wall",
+                bytes_per_particle: f64s(2 + d) + wall_fit + BiCgStab::BYTES_PER_UNKNOWN,
             },
-            Stage { name: "corrector", what: "Eq. (7) with the corrected gradient (Eq. 20, 24–25)", bytes_per_particle: 0 },
+            Stage { name: "corrector", what: "Eq. (7) with the corrected gradient (Eq. 20, 24–25); no velocity into a wall within dx of it", bytes_per_particle: 0 },
             Stage {
                 name: "advection + shifting",
-                what: "Eq. (8): r += Δt u, then Fickian shifting δr = −D∇C (Eq. 9–10)",
+                what: "Eq. (8): r += Δt u, then Fickian shifting δr = −D∇C with u and P Taylor-corrected (Eq. 9–10)",
                 bytes_per_particle: f64s(d),
             },
             Stage {

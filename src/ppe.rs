@@ -3,21 +3,21 @@
 //! * interior fluid rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt²  with the Laplacian of
 //!   Eq. (27), made first-order consistent where the free surface truncates the kernel;
 //! * free-surface rows:    P_i = 0 (Dirichlet);
-//! * wall rows:            P_w = Σ_f ω_wf (P_f + ρ_f (g − a_t,f)·(r_w − r_f)), ω_wf = W_wf/Σ_f W_wf,
-//!   the discrete Neumann condition (the kernel-weighted fluid pressure carried to the wall
-//!   particle by the fluid's momentum balance, after Adami et al. 2012; a_t is the fluid's
-//!   acceleration along the wall), plus the kinematic term for free-surface particles moving
-//!   into the wall;
+//! * wall rows:            P_w = Σ_f c_wf (P_f + ρ_f (g·n)(r_w − r_f)·n), the Neumann condition
+//!   ∂P/∂n = ρ g·n through the linear fit of `wall`;
 //! * walls with no fluid in reach: P_w = 0.
 //!
-//! After the solve, negative fluid pressures are clipped to zero (see `clip_tension`).
+//! After the solve, negative fluid pressures are clipped to zero and the wall rows re-evaluated
+//! (see `PressureOperator::clipped`).
 //!
 //! The wall rows make the system non-symmetric, hence BiCGSTAB.
 
+use crate::free_surface::Support;
 use crate::linsolve::LinearOperator;
 use crate::particles::{Kind, Particles};
 use crate::reduce::fill;
 use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Neighbours};
+use crate::wall::WallFit;
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,22 +32,21 @@ pub enum Role {
     Idle,
 }
 
-/// Assigns roles: fluid with ∇·r below `threshold` is free surface; walls are active when a
-/// fluid particle lies in their support. If the fluid has no free surface at all (a full
-/// closed box) the PPE is singular; the highest fluid particle is then pinned to P = 0.
+/// Assigns roles: fluid on the free surface (see `free_surface`) takes P = 0; walls are active when a fluid particle lies
+/// in their support. If the fluid has no free surface at all (a full closed box) the PPE is
+/// singular; the highest fluid particle is then pinned to P = 0.
 pub fn assign_roles<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    div_r: &[f64],
-    threshold: f64,
+    supports: &[Support<D>],
     gravity: [f64; D],
     roles: &mut Vec<Role>,
 ) {
     roles.resize(p.len(), Role::Idle);
     fill(roles, |i| match p.kind[i] {
-        // ∇·r barely sees near-coincident neighbours, so a particle squeezed against a wall or
-        // into a clump can look like free surface; one denser than rest never is.
-        Kind::Fluid if div_r[i] < threshold && p.density[i] < p.rest_density[i] => Role::Surface,
+        Kind::Fluid if supports[i].is_free_surface(nb, i, p.density[i] / p.rest_density[i]) => {
+            Role::Surface
+        }
         Kind::Fluid => Role::Interior,
         Kind::Wall => {
             let mut near_fluid = false;
@@ -96,42 +95,24 @@ pub fn source<const D: usize>(
     dt: f64,
     alpha: f64,
     gravity: [f64; D],
-    wall_normal: impl Fn([f64; D]) -> [f64; D] + Sync,
+    walls: &[WallFit<D>],
     b: &mut Vec<f64>,
 ) {
     b.resize(p.len(), 0.0);
     fill(b, |i| match roles[i] {
         Role::Interior => interior_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i),
         Role::Wall => {
-            // ρ (g − a_t)·(r_w − r_f): the fluid's momentum balance ∇P = ρ (g − a) with a_t the
-            // tangential part (along the wall, normal n) of the fluid's acceleration in the last
-            // step; the wall itself does not accelerate (Adami et al. 2012). For still water the
-            // hydrostatic term; along a wall where the fluid falls freely it vanishes, so dry
-            // wall above a falling surface does not suck the fluid in.
-            let n = wall_normal(p.position(i));
-            let (mut wsum, mut hydro) = (0.0, 0.0);
+            // Σ_f c_wf ρ_f g_w·(r_w − r_f): the Neumann condition of the fit (see `wall`).
+            let fit = &walls[i];
+            let g = fit.carried_gravity(gravity);
+            let mut b = 0.0;
             nb.for_each(i, |j, rij, r| {
                 if p.is_fluid(j) {
-                    let w = nb.kernel.w(r);
-                    let a: [f64; D] = std::array::from_fn(|d| p.acceleration[d][j]);
-                    let a_n: f64 = (0..D).map(|d| a[d] * n[d]).sum();
-                    let f_dot_r: f64 = (0..D)
-                        .map(|d| (gravity[d] - (a[d] - a_n * n[d])) * rij[d])
-                        .sum();
-                    // A free-surface particle has no PPE row, so the wall's kinematic condition
-                    // ∂P/∂n = (ρ/Δt) uⁿ·n for flow into the wall enters through the wall row.
-                    let approach = if roles[j] == Role::Surface {
-                        let u_n: f64 = (0..D).map(|d| p.vel[d][j] * n[d]).sum();
-                        let r_n: f64 = (0..D).map(|d| rij[d] * n[d]).sum();
-                        u_n.min(0.0) / dt * r_n
-                    } else {
-                        0.0
-                    };
-                    wsum += w;
-                    hydro += w * p.rest_density[j] * (f_dot_r + approach);
+                    let g_r: f64 = (0..D).map(|d| g[d] * rij[d]).sum();
+                    b += fit.weight(rij, r, nb) * p.rest_density[j] * g_r;
                 }
             });
-            hydro / wsum
+            b
         }
         Role::Surface | Role::Idle => 0.0,
     });
@@ -176,18 +157,6 @@ fn interior_source<const D: usize>(
     -(rho0 / dt * div + density_term)
 }
 
-/// Clips negative fluid pressures to zero after the solve, as SPlisHSPlasH's implicit solvers
-/// do: tension would pull particles into clumps. Wall pressures are kept as solved: above the
-/// free surface the hydrostatic extrapolation is negative, and only with the values the solve
-/// used does the corrector keep a still surface at rest where it meets a wall.
-pub fn clip_tension(pressure: &mut [f64], kind: &[Kind]) {
-    for (pressure, kind) in pressure.iter_mut().zip(kind) {
-        if *kind == Kind::Fluid {
-            *pressure = pressure.max(0.0);
-        }
-    }
-}
-
 /// First-order consistency of the Laplacian of Eq. (27). Where the free surface truncates the
 /// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with
 /// c_i = 2 Σ_j (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support). Subtracting
@@ -225,9 +194,34 @@ pub struct PressureOperator<'a, const D: usize> {
     pub roles: &'a [Role],
     /// ĉ_i of `laplacian_correction`.
     pub consistency: &'a [Vec<f64>; D],
+    /// The extrapolation of each wall row.
+    pub walls: &'a [WallFit<D>],
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
+    /// The pressure after the solve: negative fluid pressures clipped to zero, as
+    /// SPlisHSPlasH's implicit solvers do (the fluid cannot sustain tension, which would pull
+    /// particles into clumps), and each wall row re-evaluated from the clipped fluid pressures,
+    /// P_w = b_w + Σ_f c_wf P_f, so that no wall pulls fluid in where the fluid itself does not.
+    /// Still water is untouched: nothing is clipped there.
+    pub fn clipped(&self, b: &[f64], solved: &[f64], out: &mut [f64]) {
+        let (nb, p) = (self.nb, self.p);
+        fill(out, |i| match self.roles[i] {
+            Role::Interior | Role::Surface => solved[i].max(0.0),
+            Role::Wall => {
+                let fit = &self.walls[i];
+                let mut pw = b[i];
+                nb.for_each(i, |j, rij, r| {
+                    if p.is_fluid(j) {
+                        pw += fit.weight(rij, r, nb) * solved[j].max(0.0);
+                    }
+                });
+                pw
+            }
+            Role::Idle => solved[i],
+        });
+    }
+
     /// Coefficient of (x_i − x_j) in the interior row i: a_ij − V_j ĉ_i·∇W_ij.
     #[inline]
     fn interior_coefficient(&self, i: usize, j: usize, rij: [f64; D], r: f64) -> f64 {
@@ -250,15 +244,14 @@ impl<const D: usize> PressureOperator<'_, D> {
                 ax
             }
             Role::Wall => {
-                let (mut wsum, mut wx) = (0.0, 0.0);
-                nb.for_each(i, |j, _, r| {
+                let fit = &self.walls[i];
+                let mut wx = 0.0;
+                nb.for_each(i, |j, rij, r| {
                     if p.is_fluid(j) {
-                        let w = nb.kernel.w(r);
-                        wsum += w;
-                        wx += w * x[j];
+                        wx += fit.weight(rij, r, nb) * x[j];
                     }
                 });
-                x[i] - wx / wsum
+                x[i] - wx
             }
             Role::Surface | Role::Idle => x[i],
         }

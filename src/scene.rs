@@ -87,8 +87,6 @@ pub struct SolverSettings {
     pub cfl: f64,
     /// Smoothing length over particle spacing, h/dx.
     pub h_over_dx: f64,
-    /// Free-surface threshold on ∇·r (default 1.65 in 2D, 2.55 in 3D).
-    pub free_surface_threshold: Option<f64>,
 }
 
 impl Default for SolverSettings {
@@ -99,7 +97,6 @@ impl Default for SolverSettings {
             alpha: 0.01,
             cfl: 0.2,
             h_over_dx: 1.2,
-            free_surface_threshold: None,
         }
     }
 }
@@ -166,13 +163,6 @@ impl Scene {
             message: e.to_string().trim_end().to_owned(),
         })?;
         Validator { text, path }.scene(file)
-    }
-
-    /// Free-surface threshold on ∇·r in effect.
-    pub fn free_surface_threshold(&self) -> f64 {
-        self.solver
-            .free_surface_threshold
-            .unwrap_or(if self.dimensions == 2 { 1.65 } else { 2.55 })
     }
 
     /// Smoothing length h.
@@ -381,13 +371,6 @@ impl Validator<'_> {
             "solver.h_over_dx",
             format!("= {} must lie in [1, 2]", sv.h_over_dx),
         )?;
-        if let Some(t) = sv.free_surface_threshold {
-            self.check(
-                t > 0.0 && t < dims as f64,
-                "solver.free_surface_threshold",
-                format!("= {t} must lie in (0, {dims}) (∇·r = {dims} inside the fluid)"),
-            )?;
-        }
 
         let name = match &s.name {
             Some(n) => n.clone(),

@@ -1,6 +1,7 @@
 //! The state of a run and one projection step, Eq. (5)–(8):
 //! cell list → density and free surface → predictor → PPE → corrector → advection → diagnostics.
 
+use crate::free_surface::Support;
 use crate::grid::CellList;
 use crate::kernel::{Quintic, SUPPORT_IN_H};
 use crate::lattice;
@@ -9,7 +10,9 @@ use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::{self, fill, fill_vector};
 use crate::scene::{Aabb, Scene};
+use crate::shifting::Shifting;
 use crate::sph::{self, Correction, Neighbours};
+use crate::wall::{self, WallFit};
 use rayon::prelude::*;
 
 /// Viscous time-step limit Δt ≤ C_ν h²/ν.
@@ -19,9 +22,6 @@ const BODY_FORCE_NUMBER: f64 = 0.25;
 
 /// Smagorinsky constant Cs of Eq. (3)–(4), Δ = dx.
 const SMAGORINSKY: f64 = 0.2;
-
-/// Shifting coefficient A of D = A h |u| Δt.
-const SHIFTING_A: f64 = 2.0;
 
 /// A CFL time step below this fraction of the body-force step is a blow-up.
 const COLLAPSE_FRACTION: f64 = 1.0e-3;
@@ -77,13 +77,17 @@ struct Workspace<const D: usize> {
     cell_of: Vec<u32>,
     order: Vec<u32>,
     scratch: Vec<f64>,
-    /// Summation density and ∇·r of the step.
-    density_divr: [Vec<f64>; 2],
+    /// Summation density of the step (swapped with the particles' density).
+    density: Vec<f64>,
+    /// How the neighbours fill each kernel support (free surface, shifting).
+    supports: Vec<Support<D>>,
     roles: Vec<Role>,
     full_support: Vec<bool>,
     u_star: [Vec<f64>; D],
     /// Kernel gradient correction L_i of each particle, Eq. (25).
     corrections: Vec<Correction<D>>,
+    /// The extrapolation of each wall row.
+    walls: Vec<WallFit<D>>,
     /// Smagorinsky eddy viscosity ν_t.
     eddy: Vec<f64>,
     /// ĉ_i of the consistent Laplacian.
@@ -101,13 +105,15 @@ impl<const D: usize> Default for Workspace<D> {
             cell_of: Vec::new(),
             order: Vec::new(),
             scratch: Vec::new(),
-            density_divr: components(),
+            density: Vec::new(),
+            supports: Vec::new(),
             roles: Vec::new(),
             full_support: Vec::new(),
             u_star: components(),
             shift: components(),
             consistency: components(),
             eddy: Vec::new(),
+            walls: Vec::new(),
             corrections: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
@@ -128,7 +134,6 @@ pub struct Simulation<const D: usize> {
     spacing: f64,
     cfl: f64,
     alpha: f64,
-    free_surface_threshold: f64,
     solver: SolverParams,
     max_viscosity: f64,
     work: Workspace<D>,
@@ -162,7 +167,6 @@ impl<const D: usize> Simulation<D> {
             spacing: scene.spacing,
             cfl: scene.solver.cfl,
             alpha: scene.solver.alpha,
-            free_surface_threshold: scene.free_surface_threshold(),
             solver: SolverParams {
                 tolerance: scene.solver.tolerance,
                 max_iterations: scene.solver.max_iterations,
@@ -254,41 +258,41 @@ impl<const D: usize> Simulation<D> {
         let gravity = *gravity;
         let nb = Neighbours::new(grid, &p.pos, *kernel);
 
-        // Summation density and ∇·r; walls keep their rest density.
         for a in w
-            .density_divr
+            .u_star
             .iter_mut()
-            .chain(&mut w.u_star)
             .chain(&mut w.shift)
             .chain(&mut w.consistency)
         {
             a.resize(p.len(), 0.0);
         }
-        fill_vector(&mut w.density_divr, |i| match p.kind[i] {
-            Kind::Fluid => {
-                let (rho, div_r) = sph::density_and_position_divergence(&nb, p, i);
-                [rho, div_r]
-            }
-            Kind::Wall => [p.rest_density[i], D as f64],
+        // Summation density; walls keep their rest density.
+        w.density.resize(p.len(), 0.0);
+        fill(&mut w.density, |i| match p.kind[i] {
+            Kind::Fluid => sph::density(&nb, p, i),
+            Kind::Wall => p.rest_density[i],
         });
-        std::mem::swap(&mut p.density, &mut w.density_divr[0]);
-        let div_r = &w.density_divr[1];
-        ppe::assign_roles(
-            &nb,
-            p,
-            div_r,
-            self.free_surface_threshold,
-            gravity,
-            &mut w.roles,
-        );
-        ppe::full_support(&nb, &w.roles, &mut w.full_support);
+        std::mem::swap(&mut p.density, &mut w.density);
 
-        // Kernel gradient correction L_i, Eq. (25), once per step for every operator below.
+        // Kernel gradient correction L_i, Eq. (25), once per step for every operator below, and
+        // the smallest eigenvalue of its moment matrix for the free-surface detection.
         w.corrections.resize(p.len(), None);
-        fill(&mut w.corrections, |i| match p.kind[i] {
-            Kind::Fluid => sph::gradient_correction(&nb, p, i),
-            Kind::Wall => None,
-        });
+        w.supports.resize(p.len(), Support::FULL);
+        w.corrections
+            .par_iter_mut()
+            .zip(&mut w.supports)
+            .enumerate()
+            .for_each(|(i, (l, support))| {
+                (*l, *support) = match p.kind[i] {
+                    Kind::Fluid => {
+                        let (m, grad_c) = sph::support_moments(&nb, p, i);
+                        (sph::gradient_correction(m), Support::new(&m, grad_c))
+                    }
+                    Kind::Wall => (None, Support::FULL),
+                }
+            });
+        ppe::assign_roles(&nb, p, &w.supports, gravity, &mut w.roles);
+        ppe::full_support(&nb, &w.roles, &mut w.full_support);
         let corrections = &w.corrections;
 
         // Smagorinsky eddy viscosity, Eq. (3)–(4).
@@ -311,6 +315,15 @@ impl<const D: usize> Simulation<D> {
         });
 
         // PPE, Eq. (6), solved from the last pressure (warm start).
+        w.walls.resize(p.len(), WallFit::NONE);
+        let (container, obstacles) = (&self.container, &self.obstacles);
+        fill(&mut w.walls, |i| match w.roles[i] {
+            Role::Wall => {
+                let n = wall::wall_normal(container, obstacles, p.position(i));
+                WallFit::new(&nb, p, n, i)
+            }
+            _ => WallFit::NONE,
+        });
         ppe::source(
             &nb,
             p,
@@ -321,7 +334,7 @@ impl<const D: usize> Simulation<D> {
             dt,
             self.alpha,
             gravity,
-            |x| wall_normal(&self.container, &self.obstacles, x),
+            &w.walls,
             &mut w.rhs,
         );
         w.pressure.clone_from(&p.pressure);
@@ -333,33 +346,29 @@ impl<const D: usize> Simulation<D> {
             p,
             roles: &w.roles,
             consistency: &w.consistency,
+            walls: &w.walls,
         };
         let info = w
             .bicgstab
             .solve(&op, &w.rhs, &mut w.pressure, self.solver)
             .map_err(|source| NumericalFailure::Solver { step, time, source })?;
-        std::mem::swap(&mut p.pressure, &mut w.pressure);
-        ppe::clip_tension(&mut p.pressure, &p.kind);
+        w.scratch.resize(p.len(), 0.0);
+        op.clipped(&w.rhs, &w.pressure, &mut w.scratch);
+        std::mem::swap(&mut p.pressure, &mut w.scratch);
 
         // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient, for every
-        // fluid particle (at the free surface too, where P = 0 and walls push back). The
-        // step's acceleration (uⁿ⁺¹ − uⁿ)/Δt is kept for the wall pressure of the next step.
-        let mut acceleration = std::mem::replace(&mut p.acceleration, components());
-        fill_vector(&mut acceleration, |i| match p.kind[i] {
+        // fluid particle (at the free surface too, where P = 0 and walls push back); free-surface
+        // particles at a wall then keep no velocity into it.
+        let mut vel = std::mem::replace(&mut p.vel, components());
+        fill_vector(&mut vel, |i| match p.kind[i] {
             Kind::Fluid => {
                 let a = sph::pressure_acceleration(&nb, p, &corrections[i], i);
-                std::array::from_fn(|d| (w.u_star[d][i] - p.vel[d][i]) / dt - a[d])
+                let u = std::array::from_fn(|d| w.u_star[d][i] - dt * a[d]);
+                wall::no_penetration(&nb, p, &w.walls, self.spacing, u, i)
             }
             Kind::Wall => [0.0; D],
         });
-        p.acceleration = acceleration;
-        for d in 0..D {
-            let a = &p.acceleration[d];
-            p.vel[d]
-                .par_iter_mut()
-                .zip(a)
-                .for_each(|(v, a)| *v += dt * a);
-        }
+        p.vel = vel;
 
         // Density error where the summation density is not truncated by the free surface.
         let full = &w.full_support;
@@ -376,21 +385,42 @@ impl<const D: usize> Simulation<D> {
             }) / n_full as f64
         };
 
-        // Advection, Eq. (8), with Fickian shifting δr = −D ∇C (Eq. 10), D = A h |u| Δt
-        // (Skillen et al. 2013), each component capped at 0.1 dx. Near the free surface ∇C
-        // points out of the fluid because the kernel is truncated; there only compressed
-        // particles (clumps) are shifted.
-        let h = kernel.h();
-        fill_vector(&mut w.shift, |i| {
-            if full[i] || (p.is_fluid(i) && p.density[i] > p.rest_density[i]) {
-                let u = speed(p, i);
-                let grad_c = sph::concentration_gradient(&nb, p, i);
-                let cap = 0.1 * self.spacing;
-                grad_c.map(|g| (-SHIFTING_A * h * u * dt * g).clamp(-cap, cap))
-            } else {
-                [0.0; D]
+        // Particle shifting δr = −D ∇C (Eq. 10) at rⁿ, then velocity and pressure carried to
+        // the shifted position by Eq. (9).
+        let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
+        let shifting = Shifting::new(&nb, self.spacing, max_speed, dt);
+        fill_vector(&mut w.shift, |i| match p.kind[i] {
+            // Splashes and particles without a consistent gradient are left in place: neither
+            // ∇C nor the Taylor correction means anything there.
+            Kind::Fluid if corrections[i].is_some() && !w.supports[i].is_splash() => {
+                let dr = shifting.displacement(&nb, p, &w.supports[i], full[i], i);
+                wall::no_penetration(&nb, p, &w.walls, self.spacing, dr, i)
             }
+            _ => [0.0; D],
         });
+        let shift = &w.shift;
+        let shift_of = |i: usize| -> [f64; D] { std::array::from_fn(|d| shift[d][i]) };
+        fill_vector(&mut w.u_star, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let g =
+                    sph::velocity_gradient(&nb, p, &corrections[i], |j| p.velocity_no_slip(j), i);
+                let dr = shift_of(i);
+                std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
+            }
+            Kind::Wall => [0.0; D],
+        });
+        std::mem::swap(&mut p.vel, &mut w.u_star);
+        fill(&mut w.pressure, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let g = sph::gradient(&nb, p, &p.pressure, &corrections[i], i);
+                let dr = shift_of(i);
+                (p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>()).max(0.0)
+            }
+            Kind::Wall => p.pressure[i],
+        });
+        std::mem::swap(&mut p.pressure, &mut w.pressure);
+
+        // Advection, Eq. (8), plus the shift.
         for d in 0..D {
             let (kind, shift) = (&p.kind, &w.shift[d]);
             p.pos[d]
@@ -455,30 +485,6 @@ impl<const D: usize> Simulation<D> {
             outside || self.obstacles.iter().any(|o| o.contains(&x))
         })
     }
-}
-
-/// Unit normal of the wall at wall particle position x, pointing into the fluid: towards the
-/// container for container walls, out of the nearest face for obstacle particles.
-fn wall_normal<const D: usize>(container: &Aabb, obstacles: &[Aabb], x: [f64; D]) -> [f64; D] {
-    let to_box: [f64; D] =
-        std::array::from_fn(|d| x[d].clamp(container.min[d], container.max[d]) - x[d]);
-    let len = to_box.iter().map(|v| v * v).sum::<f64>().sqrt();
-    if len > 0.0 {
-        return to_box.map(|v| v / len);
-    }
-    let mut best = (f64::INFINITY, [0.0; D]);
-    for o in obstacles {
-        for d in 0..D {
-            for (gap, sign) in [(x[d] - o.min[d], -1.0), (o.max[d] - x[d], 1.0)] {
-                if gap.abs() < best.0 {
-                    let mut n = [0.0; D];
-                    n[d] = sign;
-                    best = (gap.abs(), n);
-                }
-            }
-        }
-    }
-    best.1
 }
 
 fn speed<const D: usize>(p: &Particles<D>, i: usize) -> f64 {

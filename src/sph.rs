@@ -53,20 +53,11 @@ impl<'a, const D: usize> Neighbours<'a, D> {
     }
 }
 
-/// Summation density ρ_i = Σ_j m_j W_ij (self included) and the position divergence
-/// ∇·r_i = −Σ_j V_j r_ij·∇W_ij with V_j = m_j/ρ0_j, used to find the free surface.
-pub fn density_and_position_divergence<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    i: usize,
-) -> (f64, f64) {
+/// Summation density ρ_i = Σ_j m_j W_ij (self included).
+pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
     let mut rho = p.mass[i] * nb.kernel.w(0.0);
-    let mut div_r = 0.0;
-    nb.for_each(i, |j, _, r| {
-        rho += p.mass[j] * nb.kernel.w(r);
-        div_r -= p.mass[j] / p.rest_density[j] * r * r * nb.kernel.grad_factor(r);
-    });
-    (rho, div_r)
+    nb.for_each(i, |j, _, r| rho += p.mass[j] * nb.kernel.w(r));
+    rho
 }
 
 /// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, the eddy viscosity of
@@ -134,13 +125,7 @@ pub fn eddy_viscosity<const D: usize>(
     cs_delta: f64,
     i: usize,
 ) -> f64 {
-    let velocity = |j: usize| -> [f64; D] {
-        match p.kind[j] {
-            Kind::Wall => [0.0; D],
-            Kind::Fluid => p.velocity(j),
-        }
-    };
-    let grad = velocity_gradient(nb, p, l, velocity, i);
+    let grad = velocity_gradient(nb, p, l, |j| p.velocity_no_slip(j), i);
     let mut ss = 0.0;
     for a in 0..D {
         for b in 0..D {
@@ -155,23 +140,29 @@ pub fn eddy_viscosity<const D: usize>(
 /// applied; below it (splashes, thin sheets, lone particles) the plain gradient is used.
 const MIN_CORRECTION_DETERMINANT: f64 = 0.1;
 
-/// Kernel gradient correction L_i = M_i⁻¹, M_i = Σ_j V_j ∇W_ij ⊗ r_ji, Eq. (24)–(25), so that
-/// L_i Σ_j V_j (φ_j − φ_i) ∇W_ij is exact for linear φ even where the support is truncated.
-/// None where M_i is near-singular.
-pub fn gradient_correction<const D: usize>(
+/// Moment matrix M_i = Σ_j V_j ∇W_ij ⊗ r_ji of Eq. (25) (symmetric; the identity for a full
+/// support) and the concentration gradient ∇C_i = Σ_j V_j ∇W_ij, from one pass.
+pub fn support_moments<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     i: usize,
-) -> Correction<D> {
-    let mut m = [[0.0; D]; D];
+) -> ([[f64; D]; D], [f64; D]) {
+    let (mut m, mut grad_c) = ([[0.0; D]; D], [0.0; D]);
     nb.for_each(i, |j, rij, r| {
         let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
         for a in 0..D {
+            grad_c[a] += vf * rij[a];
             for b in 0..D {
                 m[a][b] -= vf * rij[a] * rij[b];
             }
         }
     });
+    (m, grad_c)
+}
+
+/// Kernel gradient correction L_i = M_i⁻¹, Eq. (24)–(25), so that L_i Σ_j V_j (φ_j − φ_i) ∇W_ij
+/// is exact for linear φ even where the support is truncated. None where M_i is near-singular.
+pub fn gradient_correction<const D: usize>(m: [[f64; D]; D]) -> Correction<D> {
     invert(m)
         .filter(|(_, det)| *det > MIN_CORRECTION_DETERMINANT)
         .map(|(l, _)| l)
@@ -252,22 +243,6 @@ pub fn pressure_acceleration<const D: usize>(
     i: usize,
 ) -> [f64; D] {
     gradient(nb, p, &p.pressure, l, i).map(|g| g / p.rest_density[i])
-}
-
-/// Gradient of the particle concentration ∇C_i = Σ_j V_j ∇W_ij, V_j = m_j/ρ0_j (Eq. 10).
-pub fn concentration_gradient<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    i: usize,
-) -> [f64; D] {
-    let mut g = [0.0; D];
-    nb.for_each(i, |j, rij, r| {
-        let c = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
-        for d in 0..D {
-            g[d] += c * rij[d];
-        }
-    });
-    g
 }
 
 /// Coefficient a_ij ≥ 0 of the negative Laplacian of Eq. (27):

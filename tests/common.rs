@@ -16,19 +16,34 @@ pub struct Lattice<const D: usize> {
 
 impl<const D: usize> Lattice<D> {
     pub fn new(n: i64, dx: f64, h_over_dx: f64) -> Self {
-        let mut particles = Particles::<D>::default();
         let half = n / 2;
         let total = (n as usize).pow(D as u32);
-        for k in 0..total {
+        let points = (0..total).map(|k| {
             let mut rest = k as i64;
-            let pos = std::array::from_fn(|_| {
+            let index = std::array::from_fn(|_| {
                 let c = rest % n;
                 rest /= n;
-                (c - half) as f64 * dx
+                c - half
             });
+            (index, Kind::Fluid)
+        });
+        Self::from_indices(points, dx, h_over_dx)
+    }
+
+    /// Particles at lattice indices (position = index · dx) of the given kinds.
+    pub fn from_indices(
+        points: impl IntoIterator<Item = ([i64; D], Kind)>,
+        dx: f64,
+        h_over_dx: f64,
+    ) -> Self {
+        let mut particles = Particles::<D>::default();
+        let mut extent = 0.0_f64;
+        for (index, kind) in points {
+            let pos = index.map(|c| c as f64 * dx);
+            extent = pos.iter().fold(extent, |e, x| e.max(x.abs()));
             particles.push(NewParticle {
                 pos,
-                kind: Kind::Fluid,
+                kind,
                 fluid: 0,
                 mass: 1000.0 * dx.powi(D as i32),
                 rest_density: 1000.0,
@@ -36,7 +51,7 @@ impl<const D: usize> Lattice<D> {
             });
         }
         let kernel = Quintic::<D>::new(h_over_dx * dx);
-        let extent = (half + 2) as f64 * dx;
+        let extent = extent + 2.0 * dx;
         let mut grid = CellList::new([-extent; D], [extent; D], SUPPORT_IN_H * kernel.h());
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
         grid.sort(&particles.pos, &mut cells, &mut order)

@@ -5,6 +5,7 @@ mod common;
 mod bad_input;
 mod dam_break;
 mod determinism;
+mod free_surface;
 mod hydrostatic;
 mod kernel;
 mod linsolve;

@@ -1,0 +1,101 @@
+//! Free-surface detection (src/free_surface.rs) on blocks, a tank, sheets and a lone particle,
+//! in 2D and 3D: exactly the particles on the outside of the fluid take P = 0.
+
+use crate::common::Lattice;
+use isph::free_surface::Support;
+use isph::particles::Kind;
+use isph::sph::{density, support_moments, Neighbours};
+
+const DX: f64 = 0.01;
+const H_OVER_DX: f64 = 1.2;
+
+/// Lattice index of each fluid particle with whether it is detected as free surface.
+fn detect<const D: usize>(lat: &Lattice<D>) -> Vec<([i64; D], bool)> {
+    let p = &lat.particles;
+    let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
+    (0..p.len())
+        .filter(|&i| p.is_fluid(i))
+        .map(|i| {
+            let (m, grad_c) = support_moments(&nb, p, i);
+            let ratio = density(&nb, p, i) / p.rest_density[i];
+            let surface = Support::new(&m, grad_c).is_free_surface(&nb, i, ratio);
+            (p.position(i).map(|x| (x / DX).round() as i64), surface)
+        })
+        .collect()
+}
+
+/// Every lattice index of a box [lo, hi) per axis.
+fn box_indices<const D: usize>(lo: [i64; D], hi: [i64; D]) -> Vec<[i64; D]> {
+    let mut all = vec![[0; D]];
+    for d in 0..D {
+        all = all
+            .into_iter()
+            .flat_map(|base| {
+                (lo[d]..hi[d]).map(move |c| {
+                    let mut x = base;
+                    x[d] = c;
+                    x
+                })
+            })
+            .collect();
+    }
+    all
+}
+
+fn assert_detected<const D: usize>(lat: &Lattice<D>, expected: impl Fn([i64; D]) -> bool) {
+    let wrong: Vec<_> = detect(lat)
+        .into_iter()
+        .filter(|&(x, surface)| surface != expected(x))
+        .collect();
+    assert!(wrong.is_empty(), "{} misdetected: {wrong:?}", wrong.len());
+}
+
+fn block_outer_layer_only<const D: usize>(n: i64) {
+    let lat = Lattice::<D>::new(n, DX, H_OVER_DX);
+    let half = n / 2;
+    assert_detected(&lat, |x| x.iter().any(|c| c.abs() == half));
+}
+
+#[test]
+fn a_block_has_exactly_its_outer_layer_on_the_surface() {
+    block_outer_layer_only::<2>(15);
+    block_outer_layer_only::<3>(11);
+}
+
+/// Water `n` particles wide and deep in a tank with four wall layers on the sides and below:
+/// only the top row is free surface, also where it meets the side walls; fluid against the
+/// walls never is.
+fn tank_top_row_only<const D: usize>(n: i64) {
+    let walls = 4;
+    let lo = [-walls; D];
+    let mut hi = [n + walls; D];
+    hi[D - 1] = n;
+    let points = box_indices(lo, hi).into_iter().map(|x| {
+        let fluid = x.iter().all(|&c| (0..n).contains(&c));
+        (x, if fluid { Kind::Fluid } else { Kind::Wall })
+    });
+    let lat = Lattice::<D>::from_indices(points, DX, H_OVER_DX);
+    assert_detected(&lat, |x| x[D - 1] == n - 1);
+}
+
+#[test]
+fn in_a_tank_only_the_top_row_is_surface() {
+    tank_top_row_only::<2>(16);
+    tank_top_row_only::<3>(10);
+}
+
+#[test]
+fn sheets_and_a_lone_particle_are_surface() {
+    // A sheet one particle thick, in 2D a row, in 3D a plate.
+    let row = Lattice::<2>::from_indices((-10..=10).map(|c| ([c, 0], Kind::Fluid)), DX, H_OVER_DX);
+    assert_detected(&row, |_| true);
+    let plate = box_indices([-7, -7, 0], [8, 8, 1]).into_iter();
+    let plate = Lattice::<3>::from_indices(plate.map(|x| (x, Kind::Fluid)), DX, H_OVER_DX);
+    assert_detected(&plate, |_| true);
+    // A sheet two particles thick: both rows are surface.
+    let sheet = box_indices([-10, 0], [11, 2]).into_iter();
+    let sheet = Lattice::<2>::from_indices(sheet.map(|x| (x, Kind::Fluid)), DX, H_OVER_DX);
+    assert_detected(&sheet, |_| true);
+    let lone = Lattice::<3>::from_indices([([0, 0, 0], Kind::Fluid)], DX, H_OVER_DX);
+    assert_detected(&lone, |_| true);
+}
