@@ -222,13 +222,17 @@ impl<const D: usize> PressureOperator<'_, D> {
         });
     }
 
-    /// Coefficient of (x_i − x_j) in the interior row i: a_ij − V_j ĉ_i·∇W_ij.
+    /// Coefficient of (x_i − x_j) in the interior row i: max(a_ij − V_j ĉ_i·∇W_ij, 0).
     #[inline]
     fn interior_coefficient(&self, i: usize, j: usize, rij: [f64; D], r: f64) -> f64 {
         let (nb, p) = (self.nb, self.p);
         let c_dot_r: f64 = (0..D).map(|d| self.consistency[d][i] * rij[d]).sum();
-        laplacian_coefficient(nb, p, i, j, r)
-            - p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * c_dot_r
+        let coefficient = laplacian_coefficient(nb, p, i, j, r)
+            - p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * c_dot_r;
+        // Where the support is badly truncated (a surge tip, spray) the correction can turn a
+        // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
+        // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
+        coefficient.max(0.0)
     }
 
     /// (A x)_i.
