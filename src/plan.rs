@@ -75,7 +75,7 @@ impl Plan {
                 what: "Eq. (6) source, Eq. (27) Laplacian (first-order consistent) matrix-free in BiCGSTAB + Jacobi, warm start; walls: Neumann condition through a linear fit along the wall",
                 bytes_per_particle: f64s(2 + d) + wall_fit + BiCgStab::BYTES_PER_UNKNOWN,
             },
-            Stage { name: "corrector", what: "Eq. (7) with the corrected gradient (Eq. 20, 24–25); no velocity into a wall within dx of it", bytes_per_particle: 0 },
+            Stage { name: "corrector", what: "Eq. (7) with the corrected gradient (Eq. 20, 24–25); no velocity into a wall within dx of it", bytes_per_particle: f64s(d) },
             Stage {
                 name: "advection + shifting",
                 what: "Eq. (8): r += Δt u, then Fickian shifting δr = −D∇C with u and P Taylor-corrected (Eq. 9–10)",

@@ -92,6 +92,8 @@ struct Workspace<const D: usize> {
     eddy: Vec<f64>,
     /// ĉ_i of the consistent Laplacian.
     consistency: [Vec<f64>; D],
+    /// Normal of the wall each fluid particle touches (zero: none).
+    contact: [Vec<f64>; D],
     /// Shifting displacement δr of each particle.
     shift: [Vec<f64>; D],
     rhs: Vec<f64>,
@@ -111,6 +113,7 @@ impl<const D: usize> Default for Workspace<D> {
             full_support: Vec::new(),
             u_star: components(),
             shift: components(),
+            contact: components(),
             consistency: components(),
             eddy: Vec::new(),
             walls: Vec::new(),
@@ -263,6 +266,7 @@ impl<const D: usize> Simulation<D> {
             .iter_mut()
             .chain(&mut w.shift)
             .chain(&mut w.consistency)
+            .chain(&mut w.contact)
         {
             a.resize(p.len(), 0.0);
         }
@@ -356,15 +360,24 @@ impl<const D: usize> Simulation<D> {
         op.clipped(&w.rhs, &w.pressure, &mut w.scratch);
         std::mem::swap(&mut p.pressure, &mut w.scratch);
 
+        // The wall each fluid particle touches, for the kinematic condition on its velocity and
+        // its shift.
+        fill_vector(&mut w.contact, |i| match p.kind[i] {
+            Kind::Fluid => wall::contact_normal(&nb, p, &w.walls, self.spacing, i),
+            Kind::Wall => [0.0; D],
+        });
+        let contact = &w.contact;
+        let contact_of = |i: usize| -> [f64; D] { std::array::from_fn(|d| contact[d][i]) };
+
         // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient, for every
-        // fluid particle (at the free surface too, where P = 0 and walls push back); free-surface
-        // particles at a wall then keep no velocity into it.
+        // fluid particle (at the free surface too, where P = 0 and walls push back); particles
+        // touching a wall then keep no velocity into it.
         let mut vel = std::mem::replace(&mut p.vel, components());
         fill_vector(&mut vel, |i| match p.kind[i] {
             Kind::Fluid => {
                 let a = sph::pressure_acceleration(&nb, p, &corrections[i], i);
                 let u = std::array::from_fn(|d| w.u_star[d][i] - dt * a[d]);
-                wall::no_penetration(&nb, p, &w.walls, self.spacing, u, i)
+                wall::no_penetration(u, contact_of(i))
             }
             Kind::Wall => [0.0; D],
         });
@@ -394,7 +407,7 @@ impl<const D: usize> Simulation<D> {
             // ∇C nor the Taylor correction means anything there.
             Kind::Fluid if corrections[i].is_some() && !w.supports[i].is_splash() => {
                 let dr = shifting.displacement(&nb, p, &w.supports[i], full[i], i);
-                wall::no_penetration(&nb, p, &w.walls, self.spacing, dr, i)
+                wall::no_penetration(dr, contact_of(i))
             }
             _ => [0.0; D],
         });

@@ -126,18 +126,13 @@ impl<const D: usize> WallFit<D> {
     }
 }
 
-/// The kinematic wall condition v·n ≥ 0 for a velocity or displacement v of fluid particle i:
-/// closer to a wall particle than the spacing dx (nearer than at rest), the particle does not
-/// move further into the wall, v ← v − min(v·n, 0) n, with n the normal of the nearest wall
-/// particle. The PPE cannot impose it: the Neumann condition slaves the wall pressure to the
-/// fluid's, so it resists no approach beyond the hydrostatic; the fluid meets the wall
-/// inelastically, as it does.
-pub fn no_penetration<const D: usize>(
+/// The wall a fluid particle touches: the normal of the nearest wall particle closer than the
+/// spacing dx (nearer than at rest), or zero where there is none.
+pub fn contact_normal<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     walls: &[WallFit<D>],
     spacing: f64,
-    u: [f64; D],
     i: usize,
 ) -> [f64; D] {
     let mut nearest = (spacing, None);
@@ -146,14 +141,17 @@ pub fn no_penetration<const D: usize>(
             nearest = (r, Some(j));
         }
     });
-    match nearest.1 {
-        Some(j) => {
-            let n = walls[j].normal;
-            let u_n = dot(u, n).min(0.0);
-            std::array::from_fn(|d| u[d] - u_n * n[d])
-        }
-        None => u,
-    }
+    nearest.1.map_or([0.0; D], |j| walls[j].normal)
+}
+
+/// The kinematic wall condition v·n ≥ 0 for a velocity or displacement v of a fluid particle
+/// touching a wall of normal n (see `contact_normal`): v ← v − min(v·n, 0) n, the particle does
+/// not move further into the wall. The PPE cannot impose it: the Neumann condition slaves the
+/// wall pressure to the fluid's, so it resists no approach beyond the hydrostatic; the fluid
+/// meets the wall inelastically, as it does.
+pub fn no_penetration<const D: usize>(v: [f64; D], n: [f64; D]) -> [f64; D] {
+    let v_n = dot(v, n).min(0.0);
+    std::array::from_fn(|d| v[d] - v_n * n[d])
 }
 
 fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
