@@ -18,6 +18,7 @@ fn lattice<const D: usize>(n: usize, dx: f64) -> (Particles<D>, CellList<D>, Qui
         p.push(NewParticle {
             pos,
             kind: Kind::Fluid,
+            normal: [0.0; D],
             fluid: 0,
             mass: 1000.0 * dx.powi(D as i32),
             rest_density: 1000.0,

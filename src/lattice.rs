@@ -4,6 +4,7 @@
 use crate::kernel::SUPPORT_IN_H;
 use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
 use crate::scene::Scene;
+use crate::wall::wall_normal;
 
 /// Number of dummy wall layers that fill the kernel support 3h.
 pub fn wall_layers(scene: &Scene) -> usize {
@@ -33,6 +34,7 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
             particles.push(NewParticle {
                 pos: x,
                 kind: Kind::Fluid,
+                normal: [0.0; D],
                 fluid: b.fluid as u16,
                 mass: fluid.density * volume,
                 rest_density: fluid.density,
@@ -44,6 +46,7 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let wall = |x: [f64; D]| NewParticle {
         pos: x,
         kind: Kind::Wall,
+        normal: wall_normal(&scene.container, &scene.obstacles, x),
         fluid: NO_FLUID,
         mass: wall_density * volume,
         rest_density: wall_density,

@@ -17,6 +17,8 @@ pub const NO_FLUID: u16 = u16::MAX;
 pub struct Particles<const D: usize> {
     pub pos: [Vec<f64>; D],
     pub vel: [Vec<f64>; D],
+    /// Unit normal of the wall at a wall particle, pointing into the fluid (zero for fluid).
+    pub normal: [Vec<f64>; D],
     pub pressure: Vec<f64>,
     /// Summation density ρ_i = Σ_j m_j W_ij (fluid); the rest density for walls.
     pub density: Vec<f64>,
@@ -26,6 +28,9 @@ pub struct Particles<const D: usize> {
     /// Kinematic viscosity ν of the particle's fluid (walls: 0, they take the fluid's ν).
     pub viscosity: Vec<f64>,
     pub kind: Vec<Kind>,
+    /// How the last pressure solve saw the particle (0 interior or wall, 1 free surface,
+    /// 2 splash): written to the frames for inspection, not used by the step.
+    pub free_surface: Vec<u8>,
     pub fluid: Vec<u16>,
     pub id: Vec<u64>,
 }
@@ -35,6 +40,8 @@ pub struct Particles<const D: usize> {
 pub struct NewParticle<const D: usize> {
     pub pos: [f64; D],
     pub kind: Kind,
+    /// Wall normal (walls only).
+    pub normal: [f64; D],
     pub fluid: u16,
     pub mass: f64,
     pub rest_density: f64,
@@ -51,12 +58,14 @@ impl<const D: usize> Default for Particles<D> {
         Self {
             pos: components(),
             vel: components(),
+            normal: components(),
             pressure: Vec::new(),
             density: Vec::new(),
             mass: Vec::new(),
             rest_density: Vec::new(),
             viscosity: Vec::new(),
             kind: Vec::new(),
+            free_surface: Vec::new(),
             fluid: Vec::new(),
             id: Vec::new(),
         }
@@ -77,6 +86,7 @@ impl<const D: usize> Particles<D> {
         for d in 0..D {
             self.pos[d].push(p.pos[d]);
             self.vel[d].push(0.0);
+            self.normal[d].push(p.normal[d]);
         }
         self.id.push(self.id.len() as u64);
         self.pressure.push(0.0);
@@ -85,6 +95,7 @@ impl<const D: usize> Particles<D> {
         self.rest_density.push(p.rest_density);
         self.viscosity.push(p.viscosity);
         self.kind.push(p.kind);
+        self.free_surface.push(0);
         self.fluid.push(p.fluid);
     }
 
@@ -109,6 +120,11 @@ impl<const D: usize> Particles<D> {
     }
 
     #[inline]
+    pub fn wall_normal(&self, i: usize) -> [f64; D] {
+        std::array::from_fn(|d| self.normal[d][i])
+    }
+
+    #[inline]
     pub fn is_fluid(&self, i: usize) -> bool {
         self.kind[i] == Kind::Fluid
     }
@@ -119,7 +135,12 @@ impl<const D: usize> Particles<D> {
 
     /// Reorders every array so that new index k holds old particle `order[k]`.
     pub fn permute(&mut self, order: &[u32], scratch: &mut Vec<f64>) {
-        let f64_arrays = self.pos.iter_mut().chain(self.vel.iter_mut()).chain([
+        let f64_arrays = self
+            .pos
+            .iter_mut()
+            .chain(self.vel.iter_mut())
+            .chain(self.normal.iter_mut())
+            .chain([
             &mut self.pressure,
             &mut self.density,
             &mut self.mass,
@@ -130,6 +151,7 @@ impl<const D: usize> Particles<D> {
             permute_with(a, order, scratch);
         }
         self.kind = order.iter().map(|&o| self.kind[o as usize]).collect();
+        self.free_surface = order.iter().map(|&o| self.free_surface[o as usize]).collect();
         self.fluid = order.iter().map(|&o| self.fluid[o as usize]).collect();
         self.id = order.iter().map(|&o| self.id[o as usize]).collect();
     }

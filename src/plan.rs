@@ -6,7 +6,6 @@ use crate::lattice;
 use crate::linsolve::BiCgStab;
 use crate::particles::Kind;
 use crate::scene::Scene;
-use crate::wall::WallFit;
 use std::fmt;
 use std::mem::size_of;
 
@@ -39,16 +38,16 @@ impl Plan {
         let fluid = kinds.iter().filter(|&&k| k == Kind::Fluid).count();
         let d = scene.dimensions;
         let f64s = |n: usize| 8 * n;
-        let (support, wall_fit) = if d == 2 {
-            (size_of::<Support<2>>(), size_of::<WallFit<2>>())
+        let support = if d == 2 {
+            size_of::<Support<2>>()
         } else {
-            (size_of::<Support<3>>(), size_of::<WallFit<3>>())
+            size_of::<Support<3>>()
         };
         let stages = vec![
             Stage {
                 name: "particles",
-                what: "SoA state: position, velocity, pressure, density, mass, ρ0, ν, kind, fluid, id",
-                bytes_per_particle: f64s(2 * d + 5) + 1 + 2 + 8,
+                what: "SoA state: position, velocity, wall normal, pressure, density, mass, ρ0, ν, kind, fluid, id",
+                bytes_per_particle: f64s(3 * d + 5) + 1 + 2 + 8,
             },
             Stage {
                 name: "cell list",
@@ -57,13 +56,13 @@ impl Plan {
             },
             Stage {
                 name: "density + free surface",
-                what: "summation density; λ_min of the moment matrix, normal and scan region (Marrone et al. 2010) ⇒ free surface (P = 0)",
+                what: "summation density; λ_min of the moment matrix, normal and scan region (Marrone et al. 2010) ⇒ free surface (Robin row, P = 0 half a spacing out)",
                 bytes_per_particle: f64s(1) + support + 2,
             },
             Stage {
                 name: "kernel correction",
-                what: "L_i of Eq. (25) once per step, shared by every corrected operator",
-                bytes_per_particle: f64s(d * d + 1),
+                what: "L_i of Eq. (25) and L'_i of the pressure gradient (walls as Neumann ghosts) once per step, shared by every corrected operator",
+                bytes_per_particle: 2 * f64s(d * d + 1),
             },
             Stage {
                 name: "predictor",
@@ -72,8 +71,8 @@ impl Plan {
             },
             Stage {
                 name: "pressure Poisson equation",
-                what: "Eq. (6) source, Eq. (27) Laplacian (first-order consistent) matrix-free in BiCGSTAB + Jacobi, warm start; walls: Neumann condition through a linear fit along the wall",
-                bytes_per_particle: f64s(2 + d) + wall_fit + BiCgStab::BYTES_PER_UNKNOWN,
+                what: "Eq. (6) source, Eq. (27) Laplacian (first-order consistent) matrix-free in BiCGSTAB + Jacobi, warm start; walls: ghosts of the fluid pressure under the Neumann condition (no unknowns); free surface: Robin row",
+                bytes_per_particle: f64s(2 + d) + 1 + BiCgStab::BYTES_PER_UNKNOWN,
             },
             Stage { name: "corrector", what: "Eq. (7) with the corrected gradient (Eq. 20, 24–25); no velocity into a wall within dx of it", bytes_per_particle: f64s(d) },
             Stage {

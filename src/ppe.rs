@@ -1,70 +1,79 @@
-//! The pressure Poisson equation of Eq. (6), assembled matrix-free:
+//! The pressure Poisson equation of Eq. (6), assembled matrix-free. The unknowns are the fluid
+//! pressures; wall particles are ghosts of them (see `wall`) and hold no unknown.
 //!
-//! * interior fluid rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt²  with the Laplacian of
-//!   Eq. (27), made first-order consistent where the free surface truncates the kernel;
-//! * free-surface rows:    P_i = 0 (Dirichlet);
-//! * wall rows:            P_w = Σ_f c_wf (P_f + ρ_f (g·n)(r_w − r_f)·n), the Neumann condition
-//!   ∂P/∂n = ρ g·n through the linear fit of `wall`;
-//! * walls with no fluid in reach: P_w = 0.
-//!
-//! After the solve, negative fluid pressures are clipped to zero and the wall rows re-evaluated
-//! (see `PressureOperator::clipped`).
-//!
-//! The wall rows make the system non-symmetric, hence BiCGSTAB.
+//! * interior rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt², with the Laplacian of
+//!   Eq. (27) made first-order consistent where the free surface truncates the kernel. The wall
+//!   pairs of the Laplacian are known ghost differences and move to the right-hand side.
+//! * free-surface rows: the Robin condition P_i + δ n_i·∇P_i = 0 with δ = dx/2: P = 0 holds on
+//!   the surface itself, half a spacing beyond the centre of the outermost particle, where the
+//!   volume that particle stands for ends. (P_i = 0 at the particle would put the surface half a
+//!   spacing too low and the hydrostatic pressure ρ g dx/2 short everywhere below.) ∇P_i is the
+//!   corrected gradient of the corrector, so the boundary row and the force it produces agree.
+//! * splash rows (particles too isolated for a gradient): P_i = 0.
+//! * wall rows: P = 0, a placeholder; the walls' pressures for output are computed after the
+//!   solve from their fluid neighbours (`wall::wall_pressure`).
 
 use crate::free_surface::Support;
 use crate::linsolve::LinearOperator;
 use crate::particles::{Kind, Particles};
-use crate::reduce::fill;
+use crate::reduce::{fill, fill_vector};
 use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Neighbours};
-use crate::wall::WallFit;
+use crate::wall::{behind_walls, ghost_pressure_difference};
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Role {
     /// Fluid with a full neighbourhood: the Laplacian row.
     Interior,
-    /// Fluid at the free surface: P = 0.
+    /// Fluid on the free surface: the Robin row.
     Surface,
-    /// Wall particle with fluid in reach: the Neumann extrapolation row.
+    /// Fluid too isolated to have a pressure gradient (spray, drops): P = 0.
+    Splash,
+    /// Wall particle: no unknown.
     Wall,
-    /// Wall particle no fluid reaches: P = 0.
-    Idle,
 }
 
-/// Assigns roles: fluid on the free surface (see `free_surface`) takes P = 0; walls are active when a fluid particle lies
-/// in their support. If the fluid has no free surface at all (a full closed box) the PPE is
-/// singular; the highest fluid particle is then pinned to P = 0.
+impl Role {
+    /// Whether the particle bounds the fluid at a free surface.
+    pub fn is_free(self) -> bool {
+        matches!(self, Role::Surface | Role::Splash)
+    }
+}
+
+/// Assigns roles: fluid on the free surface (see `free_surface`) takes the Robin row, or P = 0
+/// where it has no consistent gradient. If the fluid has no free surface at all (a full closed
+/// box) the PPE is singular; the highest fluid particle is then pinned to P = 0.
 pub fn assign_roles<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     supports: &[Support<D>],
+    pressure_corrections: &[Correction<D>],
     gravity: [f64; D],
     roles: &mut Vec<Role>,
 ) {
-    roles.resize(p.len(), Role::Idle);
+    roles.resize(p.len(), Role::Wall);
     fill(roles, |i| match p.kind[i] {
-        Kind::Fluid if supports[i].is_free_surface(nb, i, p.density[i] / p.rest_density[i]) => {
-            Role::Surface
-        }
-        Kind::Fluid => Role::Interior,
-        Kind::Wall => {
-            let mut near_fluid = false;
-            nb.for_each(i, |j, _, _| near_fluid |= p.is_fluid(j));
-            if near_fluid {
-                Role::Wall
+        Kind::Fluid => {
+            let mut fluid_neighbours = 0;
+            nb.for_each(i, |j, _, _| fluid_neighbours += p.is_fluid(j) as usize);
+            let free = supports[i].is_free_surface(nb, i, p.density[i] / p.rest_density[i]);
+            if fluid_neighbours == 0 || pressure_corrections[i].is_none() {
+                Role::Splash
+            } else if free {
+                Role::Surface
             } else {
-                Role::Idle
+                Role::Interior
             }
         }
+        Kind::Wall => Role::Wall,
     });
-    if !roles.contains(&Role::Surface) {
+    if !roles.iter().any(|r| r.is_free()) {
         let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
         let top = (0..p.len())
             .filter(|&i| roles[i] == Role::Interior)
             .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)));
         if let Some(top) = top {
-            roles[top] = Role::Surface;
+            roles[top] = Role::Splash;
         }
     }
 }
@@ -77,52 +86,80 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
         if roles[i] != Role::Interior {
             return false;
         }
-        let mut any_surface = false;
-        nb.for_each(i, |j, _, _| any_surface |= roles[j] == Role::Surface);
-        !any_surface
+        let mut any_free = false;
+        nb.for_each(i, |j, _, _| any_free |= roles[j].is_free());
+        !any_free
+    });
+}
+
+/// The per-row vector of the operator, with L'_i the correction of the pressure gradient
+/// (`sph::Moments::m_neumann`): ĉ_i = L'_iᵀ c_i of the consistent Laplacian for interior rows
+/// (see `laplacian_correction`), q_i = δ L'_iᵀ n_i of the Robin condition for surface rows
+/// (δ n·∇P_i = δ n·L'_i Σ_j … = q_i·Σ_j …), zero otherwise.
+#[allow(clippy::too_many_arguments)]
+pub fn row_vectors<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    roles: &[Role],
+    pressure_corrections: &[Correction<D>],
+    supports: &[Support<D>],
+    spacing: f64,
+    out: &mut [Vec<f64>; D],
+) {
+    fill_vector(out, |i| match roles[i] {
+        Role::Interior => laplacian_correction(nb, p, &pressure_corrections[i], i),
+        Role::Surface => {
+            let n = supports[i].normal;
+            let delta = 0.5 * spacing;
+            match &pressure_corrections[i] {
+                Some(l) => std::array::from_fn(|a| delta * (0..D).map(|b| l[b][a] * n[b]).sum::<f64>()),
+                None => n.map(|x| delta * x),
+            }
+        }
+        Role::Splash | Role::Wall => [0.0; D],
     });
 }
 
 /// Right-hand side b of the PPE rows (same sign convention as `PressureOperator`).
 #[allow(clippy::too_many_arguments)]
 pub fn source<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    roles: &[Role],
+    op: &PressureOperator<D>,
     full: &[bool],
     corrections: &[Correction<D>],
     u_star: &[Vec<f64>; D],
     dt: f64,
     alpha: f64,
-    gravity: [f64; D],
-    walls: &[WallFit<D>],
     b: &mut Vec<f64>,
 ) {
+    let (nb, p) = (op.nb, op.p);
     b.resize(p.len(), 0.0);
-    fill(b, |i| match roles[i] {
-        Role::Interior => interior_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i),
-        Role::Wall => {
-            // Σ_f c_wf ρ_f g_w·(r_w − r_f): the Neumann condition of the fit (see `wall`).
-            let fit = &walls[i];
-            let g = fit.carried_gravity(gravity);
-            let mut b = 0.0;
+    fill(b, |i| match op.roles[i] {
+        Role::Interior => {
+            let mut walls = 0.0;
             nb.for_each(i, |j, rij, r| {
-                if p.is_fluid(j) {
-                    let g_r: f64 = (0..D).map(|d| g[d] * rij[d]).sum();
-                    b += fit.weight(rij, r, nb) * p.rest_density[j] * g_r;
+                if !p.is_fluid(j) {
+                    walls += op.interior_coefficient(i, j, rij, r) * op.ghost(i, j, rij);
                 }
             });
-            b
+            divergence_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i) + walls
         }
-        Role::Surface | Role::Idle => 0.0,
+        Role::Surface => {
+            let mut walls = 0.0;
+            nb.for_each(i, |j, rij, r| {
+                if !p.is_fluid(j) {
+                    walls += op.surface_coefficient(i, j, rij, r) * op.ghost(i, j, rij);
+                }
+            });
+            -walls
+        }
+        Role::Splash | Role::Wall => 0.0,
     });
 }
 
-/// Right-hand side of an interior fluid row: −(ρ0/Δt) ∇·u* − α (ρ0 − ρ_i)/Δt², Eq. (6), with
-/// ∇·u* corrected by Eq. (24)–(25) so that it is exact for linear velocity fields also where
-/// the free surface truncates the kernel support.
+/// −(ρ0/Δt) ∇·u* − α (ρ0 − ρ_i)/Δt², Eq. (6), with ∇·u* corrected by Eq. (24)–(25) so that it
+/// is exact for linear velocity fields also where the free surface truncates the kernel.
 #[allow(clippy::too_many_arguments)]
-fn interior_source<const D: usize>(
+fn divergence_source<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Correction<D>,
@@ -134,7 +171,7 @@ fn interior_source<const D: usize>(
 ) -> f64 {
     let rho_i = p.density[i];
     // Walls take the fluid's own predictor increment u*_i − uⁿ_i: the body force is carried by
-    // the wall rows, the wall's kinematic condition by the divergence.
+    // the wall ghosts' Neumann condition, the wall's kinematic condition by the divergence.
     let wall_u: [f64; D] = std::array::from_fn(|d| u_star[d][i] - p.vel[d][i]);
     let velocity = |j: usize| -> [f64; D] {
         match p.kind[j] {
@@ -159,26 +196,30 @@ fn interior_source<const D: usize>(
 
 /// First-order consistency of the Laplacian of Eq. (27). Where the free surface truncates the
 /// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with
-/// c_i = 2 Σ_j (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support). Subtracting
-/// that term, with ∇P_i the corrected gradient L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row
-/// Σ_j (a_ij − V_j (L_iᵀc_i)·∇W_ij)(P_i − P_j), still one pass over the neighbours. Without it
-/// the pressure bends under the free surface and pushes a still surface off its rest position.
-/// Returns ĉ_i = L_iᵀ c_i (zero for particles that are not interior fluid).
-pub fn laplacian_correction<const D: usize>(
+/// c_i = 2 Σ_j (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support). A wall ghost
+/// continues only the normal part of the field, so a wall neighbour contributes N_b r_ij (see
+/// `wall`): beside a plane wall the wall supplies what the missing fluid would, but in a corner
+/// or where the surface meets a wall the support is truncated for the tangential part too.
+/// Subtracting that term, with ∇P_i the corrected gradient
+/// L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij − V_j (L_iᵀc_i)·∇W_ij)(P_i − P_j),
+/// still one pass over the neighbours. Without it the pressure bends under the free surface and
+/// pushes a still surface off its rest position. Returns ĉ_i = L_iᵀ c_i, with L_i the
+/// pressure gradient correction.
+fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    roles: &[Role],
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    if roles[i] != Role::Interior {
-        return [0.0; D];
-    }
     let mut c = [0.0; D];
     nb.for_each(i, |j, rij, r| {
         let cl = 2.0 * p.mass[j] / p.rest_density[i] * nb.laplacian_factor(r);
+        let followed = match p.kind[j] {
+            Kind::Fluid => rij,
+            Kind::Wall => behind_walls(p, j, rij),
+        };
         for d in 0..D {
-            c[d] += cl * rij[d];
+            c[d] += cl * followed[d];
         }
     });
     match l {
@@ -192,47 +233,40 @@ pub struct PressureOperator<'a, const D: usize> {
     pub nb: &'a Neighbours<'a, D>,
     pub p: &'a Particles<D>,
     pub roles: &'a [Role],
-    /// ĉ_i of `laplacian_correction`.
-    pub consistency: &'a [Vec<f64>; D],
-    /// The extrapolation of each wall row.
-    pub walls: &'a [WallFit<D>],
+    /// The row vectors of `row_vectors`.
+    pub row_vectors: &'a [Vec<f64>; D],
+    pub gravity: [f64; D],
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
-    /// The pressure after the solve: negative fluid pressures clipped to zero, as
-    /// SPlisHSPlasH's implicit solvers do (the fluid cannot sustain tension, which would pull
-    /// particles into clumps), and each wall row re-evaluated from the clipped fluid pressures,
-    /// P_w = b_w + Σ_f c_wf P_f, so that no wall pulls fluid in where the fluid itself does not.
-    /// Still water is untouched: nothing is clipped there.
-    pub fn clipped(&self, b: &[f64], solved: &[f64], out: &mut [f64]) {
-        let (nb, p) = (self.nb, self.p);
-        fill(out, |i| match self.roles[i] {
-            Role::Interior | Role::Surface => solved[i].max(0.0),
-            Role::Wall => {
-                let fit = &self.walls[i];
-                let mut pw = b[i];
-                nb.for_each(i, |j, rij, r| {
-                    if p.is_fluid(j) {
-                        pw += fit.weight(rij, r, nb) * solved[j].max(0.0);
-                    }
-                });
-                pw
-            }
-            Role::Idle => solved[i],
-        });
+    #[inline]
+    fn row_vector_dot(&self, i: usize, rij: [f64; D]) -> f64 {
+        (0..D).map(|d| self.row_vectors[d][i] * rij[d]).sum()
     }
 
-    /// Coefficient of (x_i − x_j) in the interior row i: max(a_ij − V_j ĉ_i·∇W_ij, 0).
+    /// P_b − P_i of wall neighbour b of fluid particle i.
+    #[inline]
+    fn ghost(&self, i: usize, b: usize, rib: [f64; D]) -> f64 {
+        ghost_pressure_difference(self.p, self.gravity, i, b, rib)
+    }
+
+    /// Coefficient of (P_i − P_j) in the interior row i: max(a_ij − V_j ĉ_i·∇W_ij, 0).
     #[inline]
     fn interior_coefficient(&self, i: usize, j: usize, rij: [f64; D], r: f64) -> f64 {
         let (nb, p) = (self.nb, self.p);
-        let c_dot_r: f64 = (0..D).map(|d| self.consistency[d][i] * rij[d]).sum();
         let coefficient = laplacian_coefficient(nb, p, i, j, r)
-            - p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * c_dot_r;
+            - p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * self.row_vector_dot(i, rij);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
         coefficient.max(0.0)
+    }
+
+    /// Coefficient of (P_j − P_i) in the Robin row i: V_j q_i·∇W_ij.
+    #[inline]
+    fn surface_coefficient(&self, i: usize, j: usize, rij: [f64; D], r: f64) -> f64 {
+        let (nb, p) = (self.nb, self.p);
+        p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * self.row_vector_dot(i, rij)
     }
 
     /// (A x)_i.
@@ -243,21 +277,22 @@ impl<const D: usize> PressureOperator<'_, D> {
             Role::Interior => {
                 let mut ax = 0.0;
                 nb.for_each(i, |j, rij, r| {
-                    ax += self.interior_coefficient(i, j, rij, r) * (x[i] - x[j])
+                    if p.is_fluid(j) {
+                        ax += self.interior_coefficient(i, j, rij, r) * (x[i] - x[j]);
+                    }
                 });
                 ax
             }
-            Role::Wall => {
-                let fit = &self.walls[i];
-                let mut wx = 0.0;
+            Role::Surface => {
+                let mut ax = x[i];
                 nb.for_each(i, |j, rij, r| {
                     if p.is_fluid(j) {
-                        wx += fit.weight(rij, r, nb) * x[j];
+                        ax += self.surface_coefficient(i, j, rij, r) * (x[j] - x[i]);
                     }
                 });
-                x[i] - wx
+                ax
             }
-            Role::Surface | Role::Idle => x[i],
+            Role::Splash | Role::Wall => x[i],
         }
     }
 }
@@ -272,14 +307,32 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
     }
 
     fn diagonal(&self, diag: &mut [f64]) {
+        let (nb, p) = (self.nb, self.p);
         fill(diag, |i| match self.roles[i] {
             Role::Interior => {
                 let mut d = 0.0;
-                self.nb
-                    .for_each(i, |j, rij, r| d += self.interior_coefficient(i, j, rij, r));
+                nb.for_each(i, |j, rij, r| {
+                    if p.is_fluid(j) {
+                        d += self.interior_coefficient(i, j, rij, r);
+                    }
+                });
+                // A row whose every weight was clipped holds its particle at P = 0.
+                if d > 0.0 {
+                    d
+                } else {
+                    1.0
+                }
+            }
+            Role::Surface => {
+                let mut d = 1.0;
+                nb.for_each(i, |j, rij, r| {
+                    if p.is_fluid(j) {
+                        d -= self.surface_coefficient(i, j, rij, r);
+                    }
+                });
                 d
             }
-            Role::Wall | Role::Surface | Role::Idle => 1.0,
-        });
+            Role::Splash | Role::Wall => 1.0,
+        })
     }
 }

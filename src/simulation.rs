@@ -12,7 +12,7 @@ use crate::reduce::{self, fill, fill_vector};
 use crate::scene::{Aabb, Scene};
 use crate::shifting::Shifting;
 use crate::sph::{self, Correction, Neighbours};
-use crate::wall::{self, WallFit};
+use crate::wall;
 use rayon::prelude::*;
 
 /// Viscous time-step limit Δt ≤ C_ν h²/ν.
@@ -86,12 +86,13 @@ struct Workspace<const D: usize> {
     u_star: [Vec<f64>; D],
     /// Kernel gradient correction L_i of each particle, Eq. (25).
     corrections: Vec<Correction<D>>,
-    /// The extrapolation of each wall row.
-    walls: Vec<WallFit<D>>,
+    /// The correction L'_i of the pressure gradient, whose wall ghosts carry the normal part
+    /// of the gradient only (see `sph::Moments`).
+    pressure_corrections: Vec<Correction<D>>,
     /// Smagorinsky eddy viscosity ν_t.
     eddy: Vec<f64>,
-    /// ĉ_i of the consistent Laplacian.
-    consistency: [Vec<f64>; D],
+    /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
+    row_vectors: [Vec<f64>; D],
     /// Normal of the wall each fluid particle touches (zero: none).
     contact: [Vec<f64>; D],
     /// Shifting displacement δr of each particle.
@@ -114,10 +115,10 @@ impl<const D: usize> Default for Workspace<D> {
             u_star: components(),
             shift: components(),
             contact: components(),
-            consistency: components(),
+            row_vectors: components(),
             eddy: Vec::new(),
-            walls: Vec::new(),
             corrections: Vec::new(),
+            pressure_corrections: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
             bicgstab: BiCgStab::default(),
@@ -265,7 +266,7 @@ impl<const D: usize> Simulation<D> {
             .u_star
             .iter_mut()
             .chain(&mut w.shift)
-            .chain(&mut w.consistency)
+            .chain(&mut w.row_vectors)
             .chain(&mut w.contact)
         {
             a.resize(p.len(), 0.0);
@@ -278,26 +279,44 @@ impl<const D: usize> Simulation<D> {
         });
         std::mem::swap(&mut p.density, &mut w.density);
 
-        // Kernel gradient correction L_i, Eq. (25), once per step for every operator below, and
-        // the smallest eigenvalue of its moment matrix for the free-surface detection.
+        // Kernel gradient corrections, Eq. (25), once per step for every operator below, and
+        // how each support is filled, for the free-surface detection.
         w.corrections.resize(p.len(), None);
+        w.pressure_corrections.resize(p.len(), None);
         w.supports.resize(p.len(), Support::FULL);
         w.corrections
             .par_iter_mut()
+            .zip(&mut w.pressure_corrections)
             .zip(&mut w.supports)
             .enumerate()
-            .for_each(|(i, (l, support))| {
-                (*l, *support) = match p.kind[i] {
+            .for_each(|(i, ((l, lp), support))| {
+                (*l, *lp, *support) = match p.kind[i] {
                     Kind::Fluid => {
-                        let (m, grad_c) = sph::support_moments(&nb, p, i);
-                        (sph::gradient_correction(m), Support::new(&m, grad_c))
+                        let mo = sph::support_moments(&nb, p, i);
+                        (
+                            sph::gradient_correction(mo.m),
+                            sph::gradient_correction(mo.m_neumann),
+                            Support::new(&mo.m, mo.grad_c),
+                        )
                     }
-                    Kind::Wall => (None, Support::FULL),
+                    Kind::Wall => (None, None, Support::FULL),
                 }
             });
-        ppe::assign_roles(&nb, p, &w.supports, gravity, &mut w.roles);
+        ppe::assign_roles(&nb, p, &w.supports, &w.pressure_corrections, gravity, &mut w.roles);
         ppe::full_support(&nb, &w.roles, &mut w.full_support);
-        let corrections = &w.corrections;
+        fill(&mut p.free_surface, |i| match w.roles[i] {
+            Role::Surface => 1,
+            Role::Splash => 2,
+            Role::Interior | Role::Wall => 0,
+        });
+        if std::env::var("ISPH_DEBUG").is_ok() && self.step % 20 == 0 {
+            for i in 0..p.len() {
+                if p.is_fluid(i) && p.pos[1][i] > 0.46 && (p.pos[0][i] < 0.05) {
+                    eprintln!("{:?} {:?} lambda {:.3} rho {:.3} P {:.2}", p.position(i), w.roles[i], w.supports[i].lambda, p.density[i]/1000.0, p.pressure[i]);
+                }
+            }
+        }
+        let (corrections, pressure_corrections) = (&w.corrections, &w.pressure_corrections);
 
         // Smagorinsky eddy viscosity, Eq. (3)–(4).
         w.eddy.resize(p.len(), 0.0);
@@ -318,65 +337,62 @@ impl<const D: usize> Simulation<D> {
             Kind::Wall => [0.0; D],
         });
 
-        // PPE, Eq. (6), solved from the last pressure (warm start).
-        w.walls.resize(p.len(), WallFit::NONE);
-        let (container, obstacles) = (&self.container, &self.obstacles);
-        fill(&mut w.walls, |i| match w.roles[i] {
-            Role::Wall => {
-                let n = wall::wall_normal(container, obstacles, p.position(i));
-                WallFit::new(&nb, p, n, i)
-            }
-            _ => WallFit::NONE,
-        });
-        ppe::source(
+        // PPE, Eq. (6), solved from the last pressure (warm start; walls hold no unknown).
+        ppe::row_vectors(
             &nb,
             p,
             &w.roles,
+            pressure_corrections,
+            &w.supports,
+            self.spacing,
+            &mut w.row_vectors,
+        );
+        let op = PressureOperator {
+            nb: &nb,
+            p,
+            roles: &w.roles,
+            row_vectors: &w.row_vectors,
+            gravity,
+        };
+        ppe::source(
+            &op,
             &w.full_support,
             corrections,
             &w.u_star,
             dt,
             self.alpha,
-            gravity,
-            &w.walls,
             &mut w.rhs,
         );
-        w.pressure.clone_from(&p.pressure);
-        fill_vector(&mut w.consistency, |i| {
-            ppe::laplacian_correction(&nb, p, &w.roles, &corrections[i], i)
+        w.pressure.resize(p.len(), 0.0);
+        fill(&mut w.pressure, |i| match w.roles[i] {
+            Role::Interior | Role::Surface => p.pressure[i],
+            Role::Splash | Role::Wall => 0.0,
         });
-        let op = PressureOperator {
-            nb: &nb,
-            p,
-            roles: &w.roles,
-            consistency: &w.consistency,
-            walls: &w.walls,
-        };
         let info = w
             .bicgstab
             .solve(&op, &w.rhs, &mut w.pressure, self.solver)
             .map_err(|source| NumericalFailure::Solver { step, time, source })?;
-        w.scratch.resize(p.len(), 0.0);
-        op.clipped(&w.rhs, &w.pressure, &mut w.scratch);
-        std::mem::swap(&mut p.pressure, &mut w.scratch);
+        // The fluid cannot sustain tension, which would pull particles into clumps: negative
+        // pressures are clipped, as SPlisHSPlasH's implicit solvers do.
+        fill(&mut p.pressure, |i| w.pressure[i].max(0.0));
 
         // The wall each fluid particle touches, for the kinematic condition on its velocity and
         // its shift.
         fill_vector(&mut w.contact, |i| match p.kind[i] {
-            Kind::Fluid => wall::contact_normal(&nb, p, &w.walls, self.spacing, i),
+            Kind::Fluid => wall::contact_normal(&nb, p, self.spacing, i),
             Kind::Wall => [0.0; D],
         });
         let contact = &w.contact;
         let contact_of = |i: usize| -> [f64; D] { std::array::from_fn(|d| contact[d][i]) };
 
-        // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient, for every
-        // fluid particle (at the free surface too, where P = 0 and walls push back); particles
-        // touching a wall then keep no velocity into it.
+        // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the
+        // walls as ghosts; particles touching a wall then keep no velocity into it.
         let mut vel = std::mem::replace(&mut p.vel, components());
         fill_vector(&mut vel, |i| match p.kind[i] {
             Kind::Fluid => {
-                let a = sph::pressure_acceleration(&nb, p, &corrections[i], i);
-                let u = std::array::from_fn(|d| w.u_star[d][i] - dt * a[d]);
+                let grad = pressure_gradient(&nb, p, gravity, &pressure_corrections[i], i);
+                let rho0 = p.rest_density[i];
+                let u = std::array::from_fn(|d| w.u_star[d][i] - dt * grad[d] / rho0);
                 wall::no_penetration(u, contact_of(i))
             }
             Kind::Wall => [0.0; D],
@@ -401,15 +417,15 @@ impl<const D: usize> Simulation<D> {
         // Particle shifting δr = −D ∇C (Eq. 10) at rⁿ, then velocity and pressure carried to
         // the shifted position by Eq. (9).
         let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
-        let shifting = Shifting::new(&nb, self.spacing, max_speed, dt);
-        fill_vector(&mut w.shift, |i| match p.kind[i] {
-            // Splashes and particles without a consistent gradient are left in place: neither
-            // ∇C nor the Taylor correction means anything there.
-            Kind::Fluid if corrections[i].is_some() && !w.supports[i].is_splash() => {
+        let shifting = Shifting::new(&nb, self.spacing, if std::env::var("ISPH_NO_SHIFT").is_ok() { 0.0 } else { max_speed }, dt);
+        fill_vector(&mut w.shift, |i| match w.roles[i] {
+            // Splashes are left in place: neither ∇C nor the Taylor correction means anything
+            // there.
+            Role::Interior | Role::Surface => {
                 let dr = shifting.displacement(&nb, p, &w.supports[i], full[i], i);
                 wall::no_penetration(dr, contact_of(i))
             }
-            _ => [0.0; D],
+            Role::Splash | Role::Wall => [0.0; D],
         });
         let shift = &w.shift;
         let shift_of = |i: usize| -> [f64; D] { std::array::from_fn(|d| shift[d][i]) };
@@ -425,11 +441,11 @@ impl<const D: usize> Simulation<D> {
         std::mem::swap(&mut p.vel, &mut w.u_star);
         fill(&mut w.pressure, |i| match p.kind[i] {
             Kind::Fluid => {
-                let g = sph::gradient(&nb, p, &p.pressure, &corrections[i], i);
+                let g = pressure_gradient(&nb, p, gravity, &pressure_corrections[i], i);
                 let dr = shift_of(i);
                 (p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>()).max(0.0)
             }
-            Kind::Wall => p.pressure[i],
+            Kind::Wall => wall::wall_pressure(&nb, p, gravity, i),
         });
         std::mem::swap(&mut p.pressure, &mut w.pressure);
 
@@ -498,6 +514,21 @@ impl<const D: usize> Simulation<D> {
             outside || self.obstacles.iter().any(|o| o.contains(&x))
         })
     }
+}
+
+/// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25) and the walls as
+/// ghosts of its pressure (see `wall`).
+fn pressure_gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    gravity: [f64; D],
+    l: &Correction<D>,
+    i: usize,
+) -> [f64; D] {
+    sph::gradient(nb, p, l, i, |j, rij| match p.kind[j] {
+        Kind::Fluid => p.pressure[j] - p.pressure[i],
+        Kind::Wall => wall::ghost_pressure_difference(p, gravity, i, j, rij),
+    })
 }
 
 fn speed<const D: usize>(p: &Particles<D>, i: usize) -> f64 {

@@ -4,6 +4,7 @@
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::particles::{Kind, Particles};
+use crate::wall::behind_walls;
 
 /// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
 const ETA2_IN_H2: f64 = 1.0e-4;
@@ -140,24 +141,44 @@ pub fn eddy_viscosity<const D: usize>(
 /// applied; below it (splashes, thin sheets, lone particles) the plain gradient is used.
 const MIN_CORRECTION_DETERMINANT: f64 = 0.1;
 
-/// Moment matrix M_i = Σ_j V_j ∇W_ij ⊗ r_ji of Eq. (25) (symmetric; the identity for a full
-/// support) and the concentration gradient ∇C_i = Σ_j V_j ∇W_ij, from one pass.
-pub fn support_moments<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    i: usize,
-) -> ([[f64; D]; D], [f64; D]) {
-    let (mut m, mut grad_c) = ([[0.0; D]; D], [0.0; D]);
+/// The moments of a fluid particle's kernel support, from one pass over its neighbours.
+#[derive(Clone, Copy, Debug)]
+pub struct Moments<const D: usize> {
+    /// M_i = Σ_j V_j ∇W_ij ⊗ r_ji of Eq. (25), walls included (symmetric; the identity for a
+    /// full support).
+    pub m: [[f64; D]; D],
+    /// M_i with each wall neighbour's r_bi replaced by its part across the walls, N_b r_bi:
+    /// the moment of a pressure field whose wall ghosts carry only the normal gradient (see
+    /// `wall`).
+    pub m_neumann: [[f64; D]; D],
+    /// ∇C_i = Σ_j V_j ∇W_ij, the concentration gradient.
+    pub grad_c: [f64; D],
+}
+
+/// The support moments of particle i.
+pub fn support_moments<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> Moments<D> {
+    let mut mo = Moments {
+        m: [[0.0; D]; D],
+        m_neumann: [[0.0; D]; D],
+        grad_c: [0.0; D],
+    };
     nb.for_each(i, |j, rij, r| {
         let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
+        // The part of r_ij the pressure of j follows: all of it for fluid, the normal part for
+        // a wall ghost.
+        let followed = match p.kind[j] {
+            Kind::Fluid => rij,
+            Kind::Wall => behind_walls(p, j, rij),
+        };
         for a in 0..D {
-            grad_c[a] += vf * rij[a];
+            mo.grad_c[a] += vf * rij[a];
             for b in 0..D {
-                m[a][b] -= vf * rij[a] * rij[b];
+                mo.m[a][b] -= vf * rij[a] * rij[b];
+                mo.m_neumann[a][b] -= vf * rij[a] * followed[b];
             }
         }
     });
-    (m, grad_c)
+    mo
 }
 
 /// Kernel gradient correction L_i = M_i⁻¹, Eq. (24)–(25), so that L_i Σ_j V_j (φ_j − φ_i) ∇W_ij
@@ -215,34 +236,24 @@ pub fn apply_correction<const D: usize>(l: &Correction<D>, v: [f64; D]) -> [f64;
 }
 
 /// Corrected gradient of a scalar field, ∇φ_i = L_i Σ_j V_j (φ_j − φ_i) ∇W_ij, Eq. (20) with
-/// Eq. (24)–(25): exact for linear φ also where the kernel support is truncated.
+/// Eq. (24)–(25), with `difference(j, r_ij)` = φ_j − φ_i: exact for linear φ also where the
+/// kernel support is truncated.
+#[inline]
 pub fn gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    phi: &[f64],
     l: &Correction<D>,
     i: usize,
+    difference: impl Fn(usize, [f64; D]) -> f64,
 ) -> [f64; D] {
     let mut grad = [0.0; D];
     nb.for_each(i, |j, rij, r| {
-        let c = p.mass[j] / p.rest_density[j] * (phi[j] - phi[i]) * nb.kernel.grad_factor(r);
+        let c = p.mass[j] / p.rest_density[j] * difference(j, rij) * nb.kernel.grad_factor(r);
         for d in 0..D {
             grad[d] += c * rij[d];
         }
     });
     apply_correction(l, grad)
-}
-
-/// Pressure acceleration (1/ρ_i)∇P_i with the corrected gradient. The symmetric form of
-/// Eq. (23) sees only part of the kernel support at the free surface, where it lets surface
-/// particles sink into the fluid; the corrected form keeps a hydrostatic surface at rest.
-pub fn pressure_acceleration<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    l: &Correction<D>,
-    i: usize,
-) -> [f64; D] {
-    gradient(nb, p, &p.pressure, l, i).map(|g| g / p.rest_density[i])
 }
 
 /// Coefficient a_ij ≥ 0 of the negative Laplacian of Eq. (27):

@@ -44,6 +44,7 @@ impl<const D: usize> Lattice<D> {
             particles.push(NewParticle {
                 pos,
                 kind,
+                normal: [0.0; D],
                 fluid: 0,
                 mass: 1000.0 * dx.powi(D as i32),
                 rest_density: 1000.0,

@@ -21,6 +21,7 @@ fn check<const D: usize>(n: usize) {
         p.push(NewParticle {
             pos,
             kind: Kind::Fluid,
+            normal: [0.0; D],
             fluid: 0,
             mass: 1.0,
             rest_density: 1.0,
@@ -64,6 +65,7 @@ fn sort_keeps_ids_and_reports_particles_outside() {
         p.push(NewParticle {
             pos: [x, 0.5],
             kind: Kind::Fluid,
+            normal: [0.0; D],
             fluid: 0,
             mass: 1.0,
             rest_density: 1.0,

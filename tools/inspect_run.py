@@ -15,7 +15,7 @@ import h5py
 import numpy as np
 import pyvista as pv
 
-FIELDS = ["velocity", "pressure", "density", "kind", "fluid", "body", "id"]
+FIELDS = ["velocity", "pressure", "density", "kind", "fluid", "free_surface", "body", "id"]
 
 
 def main(out: Path) -> int:

@@ -106,6 +106,10 @@ impl FrameWriter {
             .write_raw(&ints(&fluid))?;
         g.new_dataset::<i32>()
             .shape(n)
+            .create("free_surface")?
+            .write_raw(&ints(&|i| p.free_surface[i] as i32))?;
+        g.new_dataset::<i32>()
+            .shape(n)
             .create("body")?
             .write_raw(&ints(&|_| -1))?;
         let ids: Vec<i64> = (0..n as i64).collect();

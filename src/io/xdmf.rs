@@ -9,12 +9,13 @@ use std::path::Path;
 pub const FILE_NAME: &str = "particles.xdmf";
 
 /// (name, attribute type, number type, precision, components) of each per-particle dataset.
-const FIELDS: [(&str, &str, &str, u8, u8); 7] = [
+const FIELDS: [(&str, &str, &str, u8, u8); 8] = [
     ("velocity", "Vector", "Float", 8, 3),
     ("pressure", "Scalar", "Float", 8, 1),
     ("density", "Scalar", "Float", 8, 1),
     ("kind", "Scalar", "Int", 4, 1),
     ("fluid", "Scalar", "Int", 4, 1),
+    ("free_surface", "Scalar", "Int", 4, 1),
     ("body", "Scalar", "Int", 4, 1),
     ("id", "Scalar", "Int", 8, 1),
 ];
