@@ -16,9 +16,9 @@ fn detect<const D: usize>(lat: &Lattice<D>) -> Vec<([i64; D], bool)> {
     (0..p.len())
         .filter(|&i| p.is_fluid(i))
         .map(|i| {
-            let (m, grad_c) = support_moments(&nb, p, i);
+            let mo = support_moments(&nb, p, i);
             let ratio = density(&nb, p, i) / p.rest_density[i];
-            let surface = Support::new(&m, grad_c).is_free_surface(&nb, i, ratio);
+            let surface = Support::new(&mo.m, mo.grad_c).is_free_surface(&nb, i, ratio);
             (p.position(i).map(|x| (x / DX).round() as i64), surface)
         })
         .collect()

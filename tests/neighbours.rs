@@ -65,7 +65,7 @@ fn sort_keeps_ids_and_reports_particles_outside() {
         p.push(NewParticle {
             pos: [x, 0.5],
             kind: Kind::Fluid,
-            normal: [0.0; D],
+            normal: [0.0; 2],
             fluid: 0,
             mass: 1.0,
             rest_density: 1.0,
