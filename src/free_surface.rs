@@ -16,10 +16,11 @@
 //!    eigenvector of λ_i, the direction in which the support is emptiest. A particle inside a
 //!    gap of the fluid or squeezed against a wall has a neighbour in every umbrella; one on
 //!    the surface has none in at least one.
-//! 3. A particle with λ_i ≤ 0.75 whose summation density is below 0.9 ρ0 is spray — loose
-//!    particles at a breaking front or an impact, each with some neighbour in every umbrella but
-//!    no fluid around it — and takes P = 0 as well. A PPE row there sees a few neighbours
-//!    converging at impact speed and answers with a pressure spike that blows the spray apart.
+//! 3. A particle whose summation density is below 0.9 ρ0 is free surface whatever λ_i says:
+//!    spray — loose particles at a breaking front or an impact, each with some neighbour in
+//!    every umbrella but no fluid around it — and sparse fluid beside a wall, whose wall
+//!    particles fill the moment matrix. A Laplacian row there sees a few neighbours converging
+//!    at impact speed and answers with a pressure spike that blows the spray apart.
 
 use crate::sph::Neighbours;
 
@@ -27,7 +28,7 @@ use crate::sph::Neighbours;
 const SPLASH_EIGENVALUE: f64 = 0.2;
 /// λ_i above which a particle is interior without the scan (Marrone et al.).
 const INTERIOR_EIGENVALUE: f64 = 0.75;
-/// ρ_i/ρ0 below which a particle with λ_i ≤ 0.75 is spray: on a lattice at h/dx = 1.2 the
+/// ρ_i/ρ0 below which a particle is spray or sparse fluid: on a lattice at h/dx = 1.2 the
 /// summation density is 0.73 ρ0 on a flat free surface and 0.97 ρ0 one row below it.
 const SPRAY_DENSITY: f64 = 0.9;
 
@@ -74,14 +75,11 @@ impl<const D: usize> Support<D> {
     /// Whether fluid particle `i` with this support and summation density ρ_i = `density_ratio`
     /// ρ0 lies on the free surface.
     pub fn is_free_surface(&self, nb: &Neighbours<D>, i: usize, density_ratio: f64) -> bool {
-        if self.is_splash() {
+        if self.is_splash() || density_ratio < SPRAY_DENSITY {
             return true;
         }
-        if self.lambda > INTERIOR_EIGENVALUE {
+        if self.lambda > INTERIOR_EIGENVALUE && std::env::var("ISPH_SCAN_ALL").is_err() {
             return false;
-        }
-        if density_ratio < SPRAY_DENSITY {
-            return true;
         }
         let directions = [self.normal, self.axis, self.axis.map(|v| -v)];
         let h = nb.kernel.h();

@@ -109,16 +109,6 @@ impl<const D: usize> Particles<D> {
         std::array::from_fn(|d| self.vel[d][i])
     }
 
-    /// Velocity of particle i with the walls at rest (the no-slip value walls take in
-    /// velocity gradients).
-    #[inline]
-    pub fn velocity_no_slip(&self, i: usize) -> [f64; D] {
-        match self.kind[i] {
-            Kind::Fluid => self.velocity(i),
-            Kind::Wall => [0.0; D],
-        }
-    }
-
     #[inline]
     pub fn wall_normal(&self, i: usize) -> [f64; D] {
         std::array::from_fn(|d| self.normal[d][i])

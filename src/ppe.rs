@@ -18,7 +18,7 @@ use crate::linsolve::LinearOperator;
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
 use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Neighbours};
-use crate::wall::{behind_walls, ghost_pressure_difference};
+use crate::wall::{behind_walls, ghost_pressure_difference, ghost_velocity};
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,7 +109,7 @@ pub fn row_vectors<const D: usize>(
     fill_vector(out, |i| match roles[i] {
         Role::Interior => laplacian_correction(nb, p, &pressure_corrections[i], i),
         Role::Surface => {
-            let n = supports[i].normal;
+            let n = contact_line_normal(nb, p, supports[i].normal, spacing, i);
             let delta = 0.5 * spacing;
             match &pressure_corrections[i] {
                 Some(l) => std::array::from_fn(|a| delta * (0..D).map(|b| l[b][a] * n[b]).sum::<f64>()),
@@ -118,6 +118,37 @@ pub fn row_vectors<const D: usize>(
         }
         Role::Splash | Role::Wall => [0.0; D],
     });
+}
+
+/// The free-surface normal for the Robin row of surface particle i. Where the surface meets a
+/// wall (a wall particle within 1.5 dx, the contact line), the free surface meets the wall at a
+/// right angle (no surface tension, no wetting), so the normal is taken along the wall: the
+/// part of −∇C_i across the wall comes from dry wall above the water standing in for fluid, and
+/// would tilt the normal off the wall and lower the boundary pressure there.
+fn contact_line_normal<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    normal: [f64; D],
+    spacing: f64,
+    i: usize,
+) -> [f64; D] {
+    let mut nearest = (1.5 * spacing, None);
+    nb.for_each(i, |j, _, r| {
+        if !p.is_fluid(j) && r < nearest.0 {
+            nearest = (r, Some(j));
+        }
+    });
+    let Some(b) = nearest.1 else {
+        return normal;
+    };
+    let across = behind_walls(p, b, normal);
+    let along: [f64; D] = std::array::from_fn(|d| normal[d] - across[d]);
+    let len = along.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if len > 0.1 {
+        along.map(|x| x / len)
+    } else {
+        normal
+    }
 }
 
 /// Right-hand side b of the PPE rows (same sign convention as `PressureOperator`).
@@ -170,13 +201,15 @@ fn divergence_source<const D: usize>(
     i: usize,
 ) -> f64 {
     let rho_i = p.density[i];
-    // Walls take the fluid's own predictor increment u*_i − uⁿ_i: the body force is carried by
-    // the wall ghosts' Neumann condition, the wall's kinematic condition by the divergence.
-    let wall_u: [f64; D] = std::array::from_fn(|d| u_star[d][i] - p.vel[d][i]);
+    // Walls take the fluid's own u*_i less its normal velocity of the last step: the body force
+    // is carried by the wall ghosts' Neumann condition, the wall's kinematic condition by the
+    // divergence (see `wall::ghost_velocity`).
+    let u_star_of = |j: usize| -> [f64; D] { std::array::from_fn(|d| u_star[d][j]) };
+    let (u_star_i, u_i) = (u_star_of(i), p.velocity(i));
     let velocity = |j: usize| -> [f64; D] {
         match p.kind[j] {
-            Kind::Wall => wall_u,
-            Kind::Fluid => std::array::from_fn(|d| u_star[d][j]),
+            Kind::Wall => ghost_velocity(p, j, u_star_i, u_i),
+            Kind::Fluid => u_star_of(j),
         }
     };
     // ∇·u* = trace of the corrected velocity gradient, Eq. (22) with Eq. (24)–(25).

@@ -320,7 +320,7 @@ impl<const D: usize> Simulation<D> {
 
         // Smagorinsky eddy viscosity, Eq. (3)–(4).
         w.eddy.resize(p.len(), 0.0);
-        let cs_delta = SMAGORINSKY * self.spacing;
+        let cs_delta = if std::env::var("ISPH_NO_LES").is_ok() { 0.0 } else { SMAGORINSKY * self.spacing };
         fill(&mut w.eddy, |i| match p.kind[i] {
             Kind::Fluid if cs_delta > 0.0 => {
                 sph::eddy_viscosity(&nb, p, &corrections[i], cs_delta, i)
@@ -432,7 +432,7 @@ impl<const D: usize> Simulation<D> {
         fill_vector(&mut w.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
                 let g =
-                    sph::velocity_gradient(&nb, p, &corrections[i], |j| p.velocity_no_slip(j), i);
+                    sph::velocity_gradient(&nb, p, &corrections[i], |j| sph::fluid_velocity(p, i, j), i);
                 let dr = shift_of(i);
                 std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
             }

@@ -4,7 +4,7 @@
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::particles::{Kind, Particles};
-use crate::wall::behind_walls;
+use crate::wall::{behind_walls, ghost_velocity};
 
 /// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
 const ETA2_IN_H2: f64 = 1.0e-4;
@@ -117,8 +117,21 @@ pub fn velocity_gradient<const D: usize>(
     })
 }
 
+/// The velocity of neighbour j in a velocity gradient at fluid particle i: its own for fluid,
+/// the free-slip ghost of u_i for walls (`wall::ghost_velocity`).
+#[inline]
+pub fn fluid_velocity<const D: usize>(p: &Particles<D>, i: usize, j: usize) -> [f64; D] {
+    match p.kind[j] {
+        Kind::Fluid => p.velocity(j),
+        Kind::Wall => {
+            let u_i = p.velocity(i);
+            ghost_velocity(p, j, u_i, u_i)
+        }
+    }
+}
+
 /// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S|, |S| = (2 S_ab S_ab)^½, S the strain rate of
-/// the corrected velocity gradient (Eq. 3–4); walls are at rest.
+/// the corrected velocity gradient (Eq. 3–4); walls are free-slip ghosts (`fluid_velocity`).
 pub fn eddy_viscosity<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
@@ -126,7 +139,7 @@ pub fn eddy_viscosity<const D: usize>(
     cs_delta: f64,
     i: usize,
 ) -> f64 {
-    let grad = velocity_gradient(nb, p, l, |j| p.velocity_no_slip(j), i);
+    let grad = velocity_gradient(nb, p, l, |j| fluid_velocity(p, i, j), i);
     let mut ss = 0.0;
     for a in 0..D {
         for b in 0..D {

@@ -43,6 +43,25 @@ pub fn behind_walls<const D: usize>(p: &Particles<D>, b: usize, r: [f64; D]) -> 
     std::array::from_fn(|d| if p.normal[d][b] != 0.0 { r[d] } else { 0.0 })
 }
 
+/// The velocity wall particle b takes in the velocity gradients of fluid particle i (the
+/// divergence of the PPE source, the strain rate of the eddy viscosity, the Taylor correction
+/// of shifting): the fluid's own velocity `u_i` with its normal part `u_n` (relative to the wall,
+/// at rest) removed, N_b here as for the pressure ghosts. The wall is then felt only through
+/// the normal velocity, the kinematic condition; along the wall it continues the fluid, a
+/// free-slip ghost. At rest in these gradients (no-slip), the wall shows a shear of order
+/// U/dx, which the kernel correction mixes into the divergence where the support is truncated
+/// (a surge front) and which a shift across it turns into a spurious change of velocity.
+#[inline]
+pub fn ghost_velocity<const D: usize>(
+    p: &Particles<D>,
+    b: usize,
+    u_i: [f64; D],
+    u_n: [f64; D],
+) -> [f64; D] {
+    let across = behind_walls(p, b, u_n);
+    std::array::from_fn(|d| u_i[d] - across[d])
+}
+
 /// Pressure of wall particle b for output and wall loads: the kernel-weighted mean of the ghost
 /// pressures its fluid neighbours give it (zero where no fluid is in reach).
 pub fn wall_pressure<const D: usize>(
