@@ -80,11 +80,23 @@ fn main() {
                 std::process::exit(128 + *signal as i32);
             }
             _ => {
-                eprintln!("error: {e:#}");
+                eprintln!("error: {}", paragraph(&e));
                 std::process::exit(1);
             }
         }
     }
+}
+
+/// The error with its causes, each cause only where the message does not already hold it (the
+/// library's errors name their cause in their own message).
+fn paragraph(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1).map(|c| c.to_string()) {
+        if !text.contains(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    text
 }
 
 fn dispatch(cli: Cli) -> anyhow::Result<()> {

@@ -316,7 +316,7 @@ impl<'a, const D: usize> Driver<'a, D> {
     }
 
     fn drive(mut self) -> Result<RunSummary, RunError> {
-        let mut progress = Progress::new(self.sim.time, self.end, self.quiet);
+        let mut progress = Progress::new(self.sim.time, self.sim.step, self.end, self.quiet);
         let (mut steps, mut ppe_total, mut last) = (0u64, 0u64, None);
         while self.sim.time < self.end {
             let (_, target) = self.next_frame_time();

@@ -5,7 +5,7 @@
 use crate::common::{command, isph_command, TempDir};
 use isph::io::checkpoint::Checkpoint;
 use isph::io::checkpoint_folder;
-use isph::particles::{ArrayMut, Particles};
+use isph::particles::{ArrayMut, Kind, Particles};
 use isph::resume::{self, ResumeOptions};
 use isph::run::{self, RunError, RunOptions, StopSignal};
 use isph::scene::Scene;
@@ -484,6 +484,52 @@ fn sigterm_stops_a_run_with_a_checkpoint_it_resumes_from() {
         "-q",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn a_numerical_failure_names_the_newest_checkpoint() {
+    let dir = TempDir::new("ckpt-failure");
+    let scene = Scene::load(&dam_break_2d(dir.path())).unwrap();
+    let out = dir.path().join("out");
+    run::run(&scene, &run_options(&out, 2.0 * scene.output_interval)).unwrap();
+    // The newest checkpoint, rewritten with a fluid particle far outside the domain: the next
+    // step finds it there.
+    let newest = newest_checkpoint(&out);
+    let checkpoint = Checkpoint::open(&newest).unwrap();
+    let mut p = Particles::<2>::default();
+    checkpoint.restore(&mut p).unwrap();
+    let fluid = p.kind.iter().position(|&k| k == Kind::Fluid).unwrap();
+    p.pos[0][fluid] = 1.0e3;
+    let folder = checkpoint_folder::folder(&out);
+    checkpoint_folder::save(&folder, &checkpoint.state, &mut p, 3).unwrap();
+    let rows = crate::common::stats_column(&out, "step").len();
+
+    let located = resume::locate(&out).unwrap();
+    let e = run::resume(&located.checkpoint, &resume_options(0.1)).unwrap_err();
+    let message = e.to_string();
+    match e {
+        RunError::Numerical {
+            last_checkpoint, ..
+        } => {
+            let saved = last_checkpoint.expect("no checkpoint named");
+            assert_eq!((saved.step, &saved.path), (checkpoint.state.step, &newest));
+        }
+        other => panic!("not a numerical failure: {other}"),
+    }
+    assert!(
+        message.contains("left the domain") && message.contains("isph resume"),
+        "{message}"
+    );
+    assert_eq!(
+        crate::common::stats_column(&out, "step").len(),
+        rows,
+        "rows written after the failure"
+    );
+    assert_eq!(
+        newest_checkpoint(&out),
+        newest,
+        "a checkpoint was written after the failure"
+    );
 }
 
 #[test]
