@@ -4,10 +4,10 @@
 
 use crate::io::checkpoint::{Checkpoint, CheckpointError};
 use crate::io::checkpoint_folder::{self, DIR_NAME};
-use crate::io::frames::{self, FrameInfo, FrameWriter};
+use crate::io::frames::{self, FrameWriter};
 use crate::io::stats::{self, StatsWriter};
 use crate::io::{xdmf, OutputError};
-use crate::run::{RunError, StopSignal};
+use crate::run::{Output, RunError, StopSignal};
 use crate::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 
@@ -105,14 +105,11 @@ pub fn locate(target: &Path) -> Result<Located, ResumeError> {
     }
 }
 
-/// A continued run, ready to step: the scene, its output directory cut back to the checkpoint
-/// and open for appending.
+/// A continued run, ready to step: the scene, and its output cut back to the checkpoint and
+/// open for appending.
 pub(crate) struct Continuation {
     pub scene: Scene,
-    pub out: PathBuf,
-    pub frames: Vec<FrameInfo>,
-    pub frames_out: FrameWriter,
-    pub stats: StatsWriter,
+    pub output: Output,
 }
 
 /// Checks that `checkpoint` can be continued (its scene unchanged unless `force`, its run's
@@ -159,10 +156,12 @@ pub(crate) fn prepare(
     xdmf::write(&out, &frames)?;
     Ok(Continuation {
         scene,
-        out,
-        frames,
-        frames_out,
-        stats,
+        output: Output {
+            dir: out,
+            frames_out,
+            stats,
+            frames,
+        },
     })
 }
 

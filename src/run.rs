@@ -114,13 +114,12 @@ fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary
     let sim = Simulation::<D>::new(scene)?;
     prepare_output_dir(&opts.out, opts.overwrite)?;
     let output = Output {
+        dir: opts.out.clone(),
         frames_out: FrameWriter::create(&opts.out)?,
         stats: StatsWriter::create(&opts.out)?,
         frames: Vec::new(),
     };
-    let mut driver = Driver::new(
-        scene, sim, &opts.out, output, None, opts.until, opts.quiet, &opts.stop,
-    );
+    let mut driver = Driver::new(scene, sim, output, None, opts.until, opts.quiet, &opts.stop);
     // Frame 0: the initial state.
     driver.write_frame_if_due()?;
     driver.drive()
@@ -145,16 +144,10 @@ fn resume_in<const D: usize>(
     checkpoint.restore(&mut sim.particles)?;
     sim.time = checkpoint.state.time;
     sim.step = checkpoint.state.step;
-    let output = Output {
-        frames_out: start.frames_out,
-        stats: start.stats,
-        frames: start.frames,
-    };
     Driver::new(
         &start.scene,
         sim,
-        &start.out,
-        output,
+        start.output,
         Some(checkpoint),
         opts.until,
         opts.quiet,
@@ -163,18 +156,18 @@ fn resume_in<const D: usize>(
     .drive()
 }
 
-/// The output files of a run, open for appending, and the frames already in them.
-struct Output {
-    frames_out: FrameWriter,
-    stats: StatsWriter,
-    frames: Vec<FrameInfo>,
+/// The output directory of a run, its files open for appending, and the frames already in them.
+pub(crate) struct Output {
+    pub dir: PathBuf,
+    pub frames_out: FrameWriter,
+    pub stats: StatsWriter,
+    pub frames: Vec<FrameInfo>,
 }
 
 /// A run in progress: the simulation and everything the run carries from step to step.
 struct Driver<'a, const D: usize> {
     scene: &'a Scene,
     sim: Simulation<D>,
-    out: PathBuf,
     end: f64,
     output: Output,
     /// The next frame falls at `next_output × output_interval`, or at the end time before it.
@@ -195,11 +188,9 @@ struct Driver<'a, const D: usize> {
 
 impl<'a, const D: usize> Driver<'a, D> {
     /// A driver for `sim`, fresh or continuing from `resumed`.
-    #[allow(clippy::too_many_arguments)]
     fn new(
         scene: &'a Scene,
         sim: Simulation<D>,
-        out: &Path,
         output: Output,
         resumed: Option<&Checkpoint>,
         until: Option<f64>,
@@ -211,7 +202,6 @@ impl<'a, const D: usize> Driver<'a, D> {
         let mut driver = Self {
             scene,
             end: until.unwrap_or(scene.end_time),
-            out: out.to_owned(),
             output,
             next_output: state.map_or(0, |s| s.next_output),
             wall_before: state.map_or(0.0, |s| s.wall_seconds),
@@ -242,7 +232,8 @@ impl<'a, const D: usize> Driver<'a, D> {
         Some(((time / interval).floor() + 1.0) * interval)
     }
 
-    /// Target of the next step: the scheduled frame time, or the end time before it.
+    /// The scheduled time of the next frame, and the next frame's time: that one, or the end
+    /// time if it comes first.
     fn next_frame_time(&self) -> (f64, f64) {
         let scheduled = self.next_output as f64 * self.scene.output_interval;
         (scheduled, scheduled.min(self.end))
@@ -260,7 +251,7 @@ impl<'a, const D: usize> Driver<'a, D> {
             .frames_out
             .write(index, &self.sim.particles, self.sim.time, self.sim.step)?;
         o.frames.push(frame);
-        xdmf::write(&self.out, &o.frames)?;
+        xdmf::write(&o.dir, &o.frames)?;
         o.stats.flush()?;
         // A frame at the end time before the scheduled one leaves that one due.
         if self.sim.time >= scheduled {
@@ -299,7 +290,7 @@ impl<'a, const D: usize> Driver<'a, D> {
             scene_path,
         };
         let path = checkpoint_folder::save(
-            &checkpoint_folder::folder(&self.out),
+            &checkpoint_folder::folder(&self.output.dir),
             &state,
             &mut self.sim.particles,
             self.scene.checkpoint.keep,
@@ -327,7 +318,7 @@ impl<'a, const D: usize> Driver<'a, D> {
                     progress.finish();
                     return Err(RunError::Numerical {
                         failure,
-                        out: self.out.clone(),
+                        out: self.output.dir.clone(),
                         last_checkpoint: self.last_saved.clone(),
                     });
                 }
@@ -348,7 +339,7 @@ impl<'a, const D: usize> Driver<'a, D> {
                 return Err(RunError::Interrupted {
                     signal,
                     saved,
-                    out: self.out,
+                    out: self.output.dir,
                 });
             }
             last = Some(step);
