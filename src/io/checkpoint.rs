@@ -15,14 +15,14 @@ use std::os::unix::ffi::OsStrExt;
 use std::path::{Path, PathBuf};
 use xxhash_rust::xxh3::Xxh3;
 
-pub const MAGIC: [u8; 8] = *b"ISPHCKPT";
+const MAGIC: [u8; 8] = *b"ISPHCKPT";
 /// Bumped whenever the layout or the meaning of a field changes.
-pub const FORMAT_VERSION: u32 = 1;
+const FORMAT_VERSION: u32 = 1;
 /// Written in the writer's byte order; a reader of the other order sees 0x04030201.
 const BYTE_ORDER_MARK: u32 = 0x0102_0304;
 /// Every array starts at a multiple of this many bytes (a cache line), so the mapped arrays are
 /// aligned for any load.
-pub const ALIGN: usize = 64;
+const ALIGN: usize = 64;
 /// Bytes of the fixed header; the array table follows it.
 const HEADER_LEN: usize = 112;
 const ENTRY_LEN: usize = 48;
@@ -61,7 +61,7 @@ pub enum CheckpointError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path} is truncated: it holds {actual} bytes where its header declares {expected} (the copy or the write was cut short); resume from an older checkpoint of the run, or give `isph resume` the output directory to pick the newest valid one")]
+    #[error("{path} is truncated: it holds {actual} of its {expected} bytes (the copy or the write was cut short); resume from an older checkpoint of the run, or give `isph resume` the output directory to pick the newest valid one")]
     Truncated {
         path: PathBuf,
         actual: u64,
@@ -270,7 +270,6 @@ pub struct Checkpoint {
     path: PathBuf,
     map: Mmap,
     dimensions: usize,
-    particle_count: usize,
     entries: Vec<Entry>,
     pub state: RunState,
 }
@@ -324,12 +323,11 @@ impl Checkpoint {
                 computed,
             });
         }
-        let (dimensions, particle_count, entries, state) = parse_layout(&map).map_err(malformed)?;
+        let (dimensions, entries, state) = parse_layout(&map).map_err(malformed)?;
         Ok(Self {
             path: path.to_owned(),
             map,
             dimensions,
-            particle_count,
             entries,
             state,
         })
@@ -341,10 +339,6 @@ impl Checkpoint {
 
     pub fn dimensions(&self) -> usize {
         self.dimensions
-    }
-
-    pub fn particle_count(&self) -> usize {
-        self.particle_count
     }
 
     /// Replaces every array of `p` by the checkpoint's (in the stored particle order). On error
@@ -411,7 +405,8 @@ impl Checkpoint {
     }
 }
 
-/// v ← the elements stored in `bytes` (64-byte aligned in the map, so viewed in place).
+/// v ← the elements stored in `bytes`, viewed in place: `parse_layout` checked that they start
+/// on a 64-byte boundary of the (page-aligned) map and hold whole elements.
 fn replace<T: bytemuck::Pod>(v: &mut Vec<T>, bytes: &[u8]) {
     v.clear();
     v.extend_from_slice(bytemuck::cast_slice(bytes));
@@ -444,7 +439,7 @@ fn check_identity(path: &Path, b: &[u8]) -> Result<(), CheckpointError> {
     }
 }
 
-type Layout = (usize, usize, Vec<Entry>, RunState);
+type Layout = (usize, Vec<Entry>, RunState);
 
 /// The header fields and array table of a file whose checksum matched; an error says what is
 /// inconsistent.
@@ -507,5 +502,5 @@ fn parse_layout(b: &[u8]) -> Result<Layout, String> {
         scene_hash: u64_at(b, 96),
         scene_path: PathBuf::from(OsStr::from_bytes(&b[path_at..path_at + path_len])),
     };
-    Ok((dims, count, entries, state))
+    Ok((dims, entries, state))
 }

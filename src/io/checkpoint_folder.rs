@@ -72,14 +72,25 @@ pub fn save<const D: usize>(
         }
     }
     let tmp = dir.join(format!(".{}{PARTIAL}", file_name(state.step)));
-    let mut file = File::create(&tmp).map_err(write_error)?;
-    checkpoint::write(&mut file, state, p).map_err(write_error)?;
-    file.sync_all().map_err(write_error)?;
-    drop(file);
+    if let Err(e) = write_synced(&tmp, state, p) {
+        // Do not leave a partial file taking the room (a full disk is the likely cause).
+        let _ = std::fs::remove_file(&tmp);
+        return Err(write_error(e));
+    }
     std::fs::rename(&tmp, &path).map_err(write_error)?;
     sync_dir(dir).map_err(write_error)?;
     prune(dir, keep).map_err(write_error)?;
     Ok(path)
+}
+
+fn write_synced<const D: usize>(
+    path: &Path,
+    state: &RunState,
+    p: &mut Particles<D>,
+) -> io::Result<()> {
+    let mut file = File::create(path)?;
+    checkpoint::write(&mut file, state, p)?;
+    file.sync_all()
 }
 
 /// Deletes all but the newest `keep` checkpoints, and what killed writers left half-written.
