@@ -146,13 +146,16 @@ pub(crate) fn prepare(
     let stats_length = stats::end_of_step(&out, state.step)?;
 
     // Every check has passed: from here on the run's future after the checkpoint is replaced.
+    // particles.h5 is opened for writing first, so that if another program holds it, nothing
+    // has changed yet.
+    let frames_out = FrameWriter::open(&out)?;
     let folder = checkpoint_folder::folder(&out);
     checkpoint_folder::remove_after(&folder, state.step).map_err(|source| OutputError::Write {
         path: folder.clone(),
         source,
     })?;
     let stats = StatsWriter::append_at(&out, stats_length)?;
-    let frames_out = FrameWriter::reopen(&out, frames.len())?;
+    frames_out.remove_frames_from(frames.len())?;
     xdmf::write(&out, &frames)?;
     Ok(Continuation {
         scene,

@@ -69,22 +69,29 @@ impl FrameWriter {
         Ok(Self { file, path })
     }
 
-    /// Continues the particles.h5 of `dir` after its first `keep` frames: later frames (written
-    /// after the checkpoint being resumed) are deleted, earlier ones are not touched.
-    pub fn reopen(dir: &Path, keep: usize) -> Result<Self, OutputError> {
+    /// Opens the particles.h5 of `dir` to append to it, changing nothing yet.
+    pub fn open(dir: &Path) -> Result<Self, OutputError> {
         let path = dir.join(FILE_NAME);
-        let hdf5_error = |source| OutputError::Hdf5 {
+        let file = hdf5::File::open_rw(&path).map_err(|source| OutputError::Hdf5 {
             path: path.clone(),
             source,
+        })?;
+        Ok(Self { file, path })
+    }
+
+    /// Deletes the frames from number `first` on (written after the checkpoint being resumed);
+    /// earlier ones are not touched.
+    pub fn remove_frames_from(&self, first: usize) -> Result<(), OutputError> {
+        let hdf5_error = |source| OutputError::Hdf5 {
+            path: self.path.clone(),
+            source,
         };
-        let file = hdf5::File::open_rw(&path).map_err(hdf5_error)?;
-        for name in file.member_names().map_err(hdf5_error)? {
-            if frame_index(&name).is_some_and(|k| k >= keep) {
-                file.unlink(&name).map_err(hdf5_error)?;
+        for name in self.file.member_names().map_err(hdf5_error)? {
+            if frame_index(&name).is_some_and(|k| k >= first) {
+                self.file.unlink(&name).map_err(hdf5_error)?;
             }
         }
-        file.flush().map_err(hdf5_error)?;
-        Ok(Self { file, path })
+        self.file.flush().map_err(hdf5_error)
     }
 
     /// Makes the frames written so far durable (before a checkpoint that counts them).
