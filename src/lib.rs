@@ -1,7 +1,8 @@
 //! isph: a stabilised incompressible SPH solver (Hassaballah, Aly & Abdelnaim 2020).
 //!
 //! A scene file becomes a [`scene::Scene`], whose particles ([`lattice`]) advance by the
-//! projection step of [`simulation::Simulation`]; [`run`] drives a whole run with its output.
+//! projection step of [`simulation::Simulation`]; [`run`] drives a whole run with its output
+//! and checkpoints, and continues one from a checkpoint ([`resume`]).
 
 pub mod free_surface;
 pub mod grid;
@@ -14,6 +15,7 @@ pub mod plan;
 pub mod ppe;
 pub mod progress;
 pub mod reduce;
+pub mod resume;
 pub mod run;
 pub mod scene;
 pub mod shifting;

@@ -3,9 +3,14 @@
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand};
 use isph::plan::Plan;
-use isph::run::{run, RunOptions};
+use isph::resume::{self, ResumeOptions};
+use isph::run::{run, RunError, RunOptions, StopSignal};
 use isph::scene::Scene;
+use signal_hook::consts::{SIGINT, SIGTERM};
+use signal_hook::flag;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 #[derive(Parser)]
 #[command(
@@ -40,11 +45,26 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
-    /// Continue a run from a checkpoint.
+    /// Continue a run from a checkpoint, in the run's output directory.
     Resume {
+        /// A checkpoint file, or a run's output directory (or its checkpoints/ folder): then
+        /// the newest valid checkpoint in it.
         checkpoint: PathBuf,
+        /// Stop at this simulated time [s] instead of the scene's end_time.
         #[arg(long)]
         until: Option<f64>,
+        /// Continue even though the scene has changed since the checkpoint was written.
+        #[arg(long)]
+        force: bool,
+        /// Scene file to use instead of the one the checkpoint names (e.g. after moving it).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Worker threads [default: all cores]. Results are bit-identical for any count.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress display.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Print the stages, particle counts and memory of a scene without running it.
     Plan { scene: PathBuf },
@@ -52,48 +72,150 @@ enum Command {
 
 fn main() {
     if let Err(e) = dispatch(Cli::parse()) {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
+        match e.downcast_ref::<RunError>() {
+            // Stopped on request, with a checkpoint: the exit code a shell gives a process
+            // ended by that signal.
+            Some(RunError::Interrupted { signal, .. }) => {
+                eprintln!("{e}");
+                std::process::exit(128 + *signal as i32);
+            }
+            _ => {
+                eprintln!("error: {}", paragraph(&e));
+                std::process::exit(1);
+            }
+        }
     }
+}
+
+/// The error with its causes, each cause only where the message does not already hold it (the
+/// library's errors name their cause in their own message).
+fn paragraph(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1).map(|c| c.to_string()) {
+        if !text.contains(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    text
 }
 
 fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, out, until, threads, overwrite, quiet } => {
-            if let Some(n) = threads {
-                if n == 0 {
-                    bail!("--threads must be at least 1");
-                }
-                rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("starting the thread pool")?;
-            }
-            if let Some(t) = until {
-                if !(t.is_finite() && t > 0.0) {
-                    bail!("--until {t}: the stop time must be a positive number of seconds");
-                }
-            }
+        Command::Run {
+            scene,
+            out,
+            until,
+            threads,
+            overwrite,
+            quiet,
+        } => {
+            start_threads(threads)?;
+            check_until(until)?;
             let scene = Scene::load(&scene)?;
             let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
-            let summary = run(&scene, &RunOptions { out: out.clone(), until, overwrite, quiet })?;
+            let stop = stop_on_signals()?;
+            let summary = run(
+                &scene,
+                &RunOptions {
+                    out: out.clone(),
+                    until,
+                    overwrite,
+                    quiet,
+                    stop,
+                },
+            )?;
             println!(
-                "{}: {} steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in {}",
+                "{}: {} steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in {}, checkpoint {}",
                 scene.name,
                 summary.steps,
                 summary.time,
                 summary.wall_seconds,
                 summary.mean_ppe_iterations,
                 summary.frames.len(),
-                out.display()
+                out.display(),
+                summary.checkpoint.path.display()
             );
             Ok(())
         }
-        Command::Resume { checkpoint, .. } => bail!(
-            "{}: resuming from checkpoints is not available yet in this version of isph (checkpoint/restart is planned); rerun with `isph run` instead",
-            checkpoint.display()
-        ),
+        Command::Resume {
+            checkpoint,
+            until,
+            force,
+            scene,
+            threads,
+            quiet,
+        } => {
+            start_threads(threads)?;
+            check_until(until)?;
+            let located = resume::locate(&checkpoint)?;
+            for skipped in &located.skipped {
+                eprintln!("warning: skipped: {skipped}");
+            }
+            let stop = stop_on_signals()?;
+            let opts = ResumeOptions {
+                until,
+                force,
+                scene,
+                quiet,
+                stop,
+            };
+            let summary = isph::run::resume(&located.checkpoint, &opts)?;
+            let state = &located.checkpoint.state;
+            println!(
+                "resumed {} at step {} (t = {} s, last Δt = {:e} s): {} more steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in all, checkpoint {}",
+                located.checkpoint.path().display(),
+                state.step,
+                state.time,
+                state.dt,
+                summary.steps,
+                summary.time,
+                summary.wall_seconds,
+                summary.mean_ppe_iterations,
+                summary.frames.len(),
+                summary.checkpoint.path.display()
+            );
+            Ok(())
+        }
         Command::Plan { scene } => {
             let scene = Scene::load(&scene)?;
             println!("{}", Plan::new(&scene));
             Ok(())
         }
     }
+}
+
+fn start_threads(threads: Option<usize>) -> anyhow::Result<()> {
+    if let Some(n) = threads {
+        if n == 0 {
+            bail!("--threads must be at least 1");
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("starting the thread pool")?;
+    }
+    Ok(())
+}
+
+fn check_until(until: Option<f64>) -> anyhow::Result<()> {
+    if let Some(t) = until {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--until {t}: the stop time must be a positive number of seconds");
+        }
+    }
+    Ok(())
+}
+
+/// SIGINT and SIGTERM stop a run after its current step, with a checkpoint; a second one ends
+/// the process at once (the checkpoints already on disk stay valid).
+fn stop_on_signals() -> anyhow::Result<StopSignal> {
+    let stop = StopSignal::default();
+    let stopping = Arc::new(AtomicBool::new(false));
+    for signal in [SIGINT, SIGTERM] {
+        flag::register_conditional_shutdown(signal, 128 + signal, Arc::clone(&stopping))
+            .and_then(|_| flag::register(signal, Arc::clone(&stopping)))
+            .and_then(|_| flag::register_usize(signal, Arc::clone(&stop), signal as usize))
+            .context("installing the SIGINT/SIGTERM handlers")?;
+    }
+    Ok(stop)
 }

@@ -10,6 +10,15 @@ pub enum Kind {
     Wall = 1,
 }
 
+impl Kind {
+    /// The kind whose `as u8` code is `code` (how checkpoints store it).
+    pub fn from_code(code: u8) -> Option<Kind> {
+        [Kind::Fluid, Kind::Wall]
+            .into_iter()
+            .find(|k| *k as u8 == code)
+    }
+}
+
 /// `fluid` index stored for particles that belong to no fluid (walls).
 pub const NO_FLUID: u16 = u16::MAX;
 
@@ -33,6 +42,15 @@ pub struct Particles<const D: usize> {
     pub free_surface: Vec<u8>,
     pub fluid: Vec<u16>,
     pub id: Vec<u64>,
+}
+
+/// One per-particle array of `Particles::arrays_mut`, by element type.
+pub enum ArrayMut<'a> {
+    F64(&'a mut Vec<f64>),
+    U64(&'a mut Vec<u64>),
+    U16(&'a mut Vec<u16>),
+    U8(&'a mut Vec<u8>),
+    Kind(&'a mut Vec<Kind>),
 }
 
 /// Everything needed to create one particle.
@@ -123,27 +141,61 @@ impl<const D: usize> Particles<D> {
         self.kind.iter().filter(|&&k| k == Kind::Fluid).count()
     }
 
+    /// Every per-particle array under a stable name: position_x, …, id. `permute` and the
+    /// checkpoints walk this one list, so an array added to `Particles` is re-sorted and saved
+    /// once it is listed here; the exhaustive destructuring below makes forgetting it a compile
+    /// error.
+    pub fn arrays_mut(&mut self) -> Vec<(&'static str, ArrayMut<'_>)> {
+        let Particles {
+            pos,
+            vel,
+            normal,
+            pressure,
+            density,
+            mass,
+            rest_density,
+            viscosity,
+            kind,
+            free_surface,
+            fluid,
+            id,
+        } = self;
+        let vectors = [
+            (pos, ["position_x", "position_y", "position_z"]),
+            (vel, ["velocity_x", "velocity_y", "velocity_z"]),
+            (normal, ["normal_x", "normal_y", "normal_z"]),
+        ];
+        let mut arrays = Vec::with_capacity(3 * D + 9);
+        for (v, names) in vectors {
+            for (name, component) in names.into_iter().zip(v.iter_mut()) {
+                arrays.push((name, ArrayMut::F64(component)));
+            }
+        }
+        arrays.extend([
+            ("pressure", ArrayMut::F64(pressure)),
+            ("density", ArrayMut::F64(density)),
+            ("mass", ArrayMut::F64(mass)),
+            ("rest_density", ArrayMut::F64(rest_density)),
+            ("viscosity", ArrayMut::F64(viscosity)),
+            ("kind", ArrayMut::Kind(kind)),
+            ("free_surface", ArrayMut::U8(free_surface)),
+            ("fluid", ArrayMut::U16(fluid)),
+            ("id", ArrayMut::U64(id)),
+        ]);
+        arrays
+    }
+
     /// Reorders every array so that new index k holds old particle `order[k]`.
     pub fn permute(&mut self, order: &[u32], scratch: &mut Vec<f64>) {
-        let f64_arrays = self
-            .pos
-            .iter_mut()
-            .chain(self.vel.iter_mut())
-            .chain(self.normal.iter_mut())
-            .chain([
-            &mut self.pressure,
-            &mut self.density,
-            &mut self.mass,
-            &mut self.rest_density,
-            &mut self.viscosity,
-        ]);
-        for a in f64_arrays {
-            permute_with(a, order, scratch);
+        for (_, array) in self.arrays_mut() {
+            match array {
+                ArrayMut::F64(a) => permute_with(a, order, scratch),
+                ArrayMut::U64(a) => *a = gathered(a, order),
+                ArrayMut::U16(a) => *a = gathered(a, order),
+                ArrayMut::U8(a) => *a = gathered(a, order),
+                ArrayMut::Kind(a) => *a = gathered(a, order),
+            }
         }
-        self.kind = order.iter().map(|&o| self.kind[o as usize]).collect();
-        self.free_surface = order.iter().map(|&o| self.free_surface[o as usize]).collect();
-        self.fluid = order.iter().map(|&o| self.fluid[o as usize]).collect();
-        self.id = order.iter().map(|&o| self.id[o as usize]).collect();
     }
 
     /// Index of each id: `index_of_id[id] = i` (for writing frames in id order).
@@ -154,6 +206,11 @@ impl<const D: usize> Particles<D> {
         }
         by_id
     }
+}
+
+/// a[order] as a new vector.
+fn gathered<T: Copy>(a: &[T], order: &[u32]) -> Vec<T> {
+    order.iter().map(|&o| a[o as usize]).collect()
 }
 
 /// a ← a[order], through a reusable scratch buffer.

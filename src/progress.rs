@@ -26,8 +26,9 @@ pub enum Progress {
 }
 
 impl Progress {
-    /// A bar if stderr is a terminal, else plain lines; `quiet` shows nothing.
-    pub fn new(start_time: f64, end: f64, quiet: bool) -> Self {
+    /// A bar if stderr is a terminal, else plain lines; `quiet` shows nothing. A resumed run
+    /// starts at `start_time` and `start_step`.
+    pub fn new(start_time: f64, start_step: u64, end: f64, quiet: bool) -> Self {
         let now = Instant::now();
         if quiet {
             Progress::Quiet
@@ -41,14 +42,14 @@ impl Progress {
                 bar,
                 end,
                 last: now,
-                last_step: 0,
+                last_step: start_step,
             }
         } else {
             Progress::Lines {
                 start: now,
                 end,
                 last: now,
-                last_step: 0,
+                last_step: start_step,
                 start_time,
             }
         }

@@ -35,6 +35,8 @@ struct SceneFile {
     obstacle: Vec<BoxSection>,
     #[serde(default)]
     solver: SolverSettings,
+    #[serde(default)]
+    checkpoint: CheckpointSection,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -101,6 +103,35 @@ impl Default for SolverSettings {
     }
 }
 
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CheckpointSection {
+    interval: Option<f64>,
+    wall_interval: Option<f64>,
+    keep: Option<i64>,
+}
+
+/// The `[checkpoint]` section: when restart files are written to `OUT/checkpoints/`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckpointSettings {
+    /// Simulated seconds between checkpoints (None: none by simulated time).
+    pub interval: Option<f64>,
+    /// Wall-clock seconds between checkpoints.
+    pub wall_interval: f64,
+    /// How many checkpoints are kept; older ones are deleted once a new one is on disk.
+    pub keep: usize,
+}
+
+impl Default for CheckpointSettings {
+    fn default() -> Self {
+        Self {
+            interval: None,
+            wall_interval: 1800.0,
+            keep: 2,
+        }
+    }
+}
+
 /// An axis-aligned box [min, max].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Aabb {
@@ -144,6 +175,7 @@ pub struct Scene {
     pub container: Aabb,
     pub obstacles: Vec<Aabb>,
     pub solver: SolverSettings,
+    pub checkpoint: CheckpointSettings,
 }
 
 impl Scene {
@@ -168,6 +200,23 @@ impl Scene {
     /// Smoothing length h.
     pub fn smoothing_length(&self) -> f64 {
         self.solver.h_over_dx * self.spacing
+    }
+
+    /// A hash of everything in the validated scene that shapes the trajectory: xxh3-64 of its
+    /// Debug rendering (which prints every f64 so that it reads back to the same bits), with the
+    /// fields that cannot change a step blanked: the file's path, the run's name, `end_time`
+    /// (`--until` overrides it anyway) and the checkpoint cadence. So comments, formatting and
+    /// defaults written out do not count, and a run can be extended or checkpointed differently
+    /// and still resume without `--force`.
+    pub fn content_hash(&self) -> u64 {
+        let trajectory = Scene {
+            path: PathBuf::new(),
+            name: String::new(),
+            end_time: 0.0,
+            checkpoint: CheckpointSettings::default(),
+            ..self.clone()
+        };
+        xxhash_rust::xxh3::xxh3_64(format!("{trajectory:?}").as_bytes())
     }
 }
 
@@ -372,6 +421,8 @@ impl Validator<'_> {
             format!("= {} must lie in [1, 2]", sv.h_over_dx),
         )?;
 
+        let checkpoint = self.checkpoint(&f.checkpoint)?;
+
         let name = match &s.name {
             Some(n) => n.clone(),
             None => self
@@ -393,6 +444,27 @@ impl Validator<'_> {
             container,
             obstacles,
             solver: f.solver,
+            checkpoint,
+        })
+    }
+
+    fn checkpoint(&self, c: &CheckpointSection) -> Result<CheckpointSettings, SceneError> {
+        let default = CheckpointSettings::default();
+        if let Some(interval) = c.interval {
+            self.positive(interval, "checkpoint.interval", "s")?;
+        }
+        let wall_interval = c.wall_interval.unwrap_or(default.wall_interval);
+        self.positive(wall_interval, "checkpoint.wall_interval", "s")?;
+        let keep = c.keep.unwrap_or(default.keep as i64);
+        self.check(
+            keep >= 1,
+            "checkpoint.keep",
+            format!("= {keep} must be at least 1 (the newest checkpoint is always kept)"),
+        )?;
+        Ok(CheckpointSettings {
+            interval: c.interval,
+            wall_interval,
+            keep: keep as usize,
         })
     }
 }

@@ -1,9 +1,9 @@
 //! Bad input: one clear paragraph naming the file and key (and line), exit code ≠ 0, no panic,
 //! and nothing already written is touched.
 
-use crate::common::TempDir;
+use crate::common::{isph_command, TempDir};
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 const GOOD: &str = r#"[simulation]
 dimensions = 2
@@ -28,10 +28,7 @@ max = [0.4, 0.3]
 "#;
 
 fn isph(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_isph"))
-        .args(args)
-        .output()
-        .unwrap()
+    isph_command().args(args).output().unwrap()
 }
 
 /// Runs `isph run` on `scene` text and returns (exit code, stderr).
@@ -165,15 +162,4 @@ fn an_existing_run_is_never_overwritten_by_accident() {
     );
     let (code, stderr) = run_text(dir.path(), GOOD, &["--overwrite"]);
     assert_eq!(code, 0, "{stderr}");
-}
-
-#[test]
-fn resume_says_it_is_not_available_yet() {
-    let o = isph(&["resume", "out/x/checkpoints/c.ckpt"]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_refused(
-        o.status.code().unwrap_or(-1),
-        &stderr,
-        &["not available yet"],
-    );
 }

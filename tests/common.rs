@@ -5,7 +5,9 @@ use isph::kernel::{Quintic, SUPPORT_IN_H};
 use isph::particles::{Kind, NewParticle, Particles};
 use isph::run::{run, RunOptions, RunSummary};
 use isph::scene::Scene;
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 /// A block of `n` fluid particles per axis at spacing `dx` around the origin, sorted by cell.
 pub struct Lattice<const D: usize> {
@@ -114,6 +116,7 @@ pub fn run_scene(scene: &Scene, out: &Path, until: f64) -> RunSummary {
         until: Some(until),
         overwrite: true,
         quiet: true,
+        stop: Default::default(),
     };
     run(scene, &opts).unwrap_or_else(|e| panic!("{e}"))
 }
@@ -140,4 +143,26 @@ pub fn stats_column(out: &Path, name: &str) -> Vec<f64> {
     lines
         .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
         .collect()
+}
+
+/// A command whose process inherits no file descriptor but stdin, stdout and stderr. HDF5 opens
+/// files without O_CLOEXEC and holds a lock on them, so a child spawned while another test is
+/// writing a run would otherwise keep that run's particles.h5 locked until it exits.
+pub fn command(program: &str) -> Command {
+    let mut c = Command::new(program);
+    // SAFETY: close(2) is async-signal-safe, and nothing else runs between fork and exec.
+    unsafe {
+        c.pre_exec(|| {
+            for fd in 3..1024 {
+                libc::close(fd);
+            }
+            Ok(())
+        });
+    }
+    c
+}
+
+/// The isph binary under test, as a `command`.
+pub fn isph_command() -> Command {
+    command(env!("CARGO_BIN_EXE_isph"))
 }

@@ -3,6 +3,7 @@
 mod common;
 
 mod bad_input;
+mod checkpoint;
 mod dam_break;
 mod determinism;
 mod free_surface;

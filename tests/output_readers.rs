@@ -1,7 +1,6 @@
 //! The output opens in real readers: VTK's XDMF reader (through pyvista) and h5py.
 
-use crate::common::{run_scene, shipped_scene, TempDir};
-use std::process::Command;
+use crate::common::{command, run_scene, shipped_scene, TempDir};
 
 #[test]
 fn pyvista_and_h5py_read_the_run_as_a_time_series() {
@@ -10,7 +9,7 @@ fn pyvista_and_h5py_read_the_run_as_a_time_series() {
     let dir = TempDir::new("readers");
     let summary = run_scene(&scene, dir.path(), 0.06);
     let tool = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/inspect_run.py");
-    let out = Command::new("python3")
+    let out = command("python3")
         .arg(tool)
         .arg(dir.path())
         .output()

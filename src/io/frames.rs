@@ -16,6 +16,44 @@ pub struct FrameInfo {
     pub count: usize,
 }
 
+fn group_name(index: usize) -> String {
+    format!("frame_{index:06}")
+}
+
+fn frame_index(group: &str) -> Option<usize> {
+    group.strip_prefix("frame_")?.parse().ok()
+}
+
+/// The first `count` frames of the particles.h5 of `dir`, read without changing the file.
+pub fn read_index(dir: &Path, count: usize) -> Result<Vec<FrameInfo>, OutputError> {
+    let path = dir.join(FILE_NAME);
+    let hdf5_error = |source| OutputError::Hdf5Read {
+        path: path.clone(),
+        source,
+    };
+    let file = hdf5::File::open(&path).map_err(hdf5_error)?;
+    (0..count)
+        .map(|index| {
+            let group = group_name(index);
+            let g = file.group(&group).map_err(|_| OutputError::Mismatch {
+                path: path.clone(),
+                what: format!(
+                    "it lacks `{group}`, one of the {count} frames the checkpoint counts"
+                ),
+            })?;
+            let info = || -> hdf5::Result<FrameInfo> {
+                Ok(FrameInfo {
+                    time: g.attr("time")?.read_scalar()?,
+                    step: g.attr("step")?.read_scalar()?,
+                    count: g.dataset("id")?.size(),
+                    group: group.clone(),
+                })
+            };
+            info().map_err(hdf5_error)
+        })
+        .collect()
+}
+
 pub struct FrameWriter {
     file: hdf5::File,
     path: PathBuf,
@@ -31,6 +69,43 @@ impl FrameWriter {
         Ok(Self { file, path })
     }
 
+    /// Opens the particles.h5 of `dir` to append to it, changing nothing yet.
+    pub fn open(dir: &Path) -> Result<Self, OutputError> {
+        let path = dir.join(FILE_NAME);
+        let file = hdf5::File::open_rw(&path).map_err(|source| OutputError::Hdf5 {
+            path: path.clone(),
+            source,
+        })?;
+        Ok(Self { file, path })
+    }
+
+    /// Deletes the frames from number `first` on (written after the checkpoint being resumed);
+    /// earlier ones are not touched.
+    pub fn remove_frames_from(&self, first: usize) -> Result<(), OutputError> {
+        let hdf5_error = |source| OutputError::Hdf5 {
+            path: self.path.clone(),
+            source,
+        };
+        for name in self.file.member_names().map_err(hdf5_error)? {
+            if frame_index(&name).is_some_and(|k| k >= first) {
+                self.file.unlink(&name).map_err(hdf5_error)?;
+            }
+        }
+        self.file.flush().map_err(hdf5_error)
+    }
+
+    /// Makes the frames written so far durable (before a checkpoint that counts them).
+    pub fn sync(&self) -> Result<(), OutputError> {
+        let err = |source| OutputError::Write {
+            path: self.path.clone(),
+            source,
+        };
+        std::fs::File::open(&self.path)
+            .map_err(err)?
+            .sync_all()
+            .map_err(err)
+    }
+
     /// Appends frame number `index` and flushes the file.
     pub fn write<const D: usize>(
         &mut self,
@@ -39,7 +114,7 @@ impl FrameWriter {
         time: f64,
         step: u64,
     ) -> Result<FrameInfo, OutputError> {
-        let group = format!("frame_{index:06}");
+        let group = group_name(index);
         self.write_group(&group, p, time, step)
             .map_err(|source| OutputError::Hdf5 {
                 path: self.path.clone(),

@@ -1,6 +1,8 @@
-//! Run output: HDF5 frames with their XDMF index, the per-step `stats.csv`, and the output
-//! directory itself (never overwritten by accident).
+//! Run output: HDF5 frames with their XDMF index, the per-step `stats.csv`, checkpoints, and
+//! the output directory itself (never overwritten by accident).
 
+pub mod checkpoint;
+pub mod checkpoint_folder;
 pub mod frames;
 pub mod stats;
 pub mod xdmf;
@@ -14,7 +16,7 @@ pub enum OutputError {
         dir: PathBuf,
         source: std::io::Error,
     },
-    #[error("output directory {dir} already holds a run ({file}); pass --overwrite to replace it, or choose another --out")]
+    #[error("output directory {dir} already holds a run ({file}); pass --overwrite to replace it, `isph resume` to continue it, or choose another --out")]
     HoldsRun { dir: PathBuf, file: String },
     #[error("cannot write {path}: {source}")]
     Write {
@@ -23,13 +25,23 @@ pub enum OutputError {
     },
     #[error("cannot write {path}: {source}")]
     Hdf5 { path: PathBuf, source: hdf5::Error },
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot read {path}: {source}")]
+    Hdf5Read { path: PathBuf, source: hdf5::Error },
+    #[error("{path} does not belong with the checkpoint: {what}")]
+    Mismatch { path: PathBuf, what: String },
 }
 
 /// Files that make a directory an isph run.
 pub const RUN_FILES: [&str; 3] = [frames::FILE_NAME, xdmf::FILE_NAME, stats::FILE_NAME];
 
 /// Creates `dir` if needed and checks it can hold a new run: it must be writable, and must
-/// not already hold one unless `overwrite` (then the old run's files are removed).
+/// not already hold one unless `overwrite` (then the old run's files and checkpoints are removed,
+/// so that `isph resume` cannot pick up a checkpoint of the old run).
 pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError> {
     let dir_error = |source| OutputError::Directory {
         dir: dir.to_owned(),
@@ -46,6 +58,16 @@ pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError
             }
             std::fs::remove_file(dir.join(file)).map_err(dir_error)?;
         }
+    }
+    let checkpoints = checkpoint_folder::folder(dir);
+    if checkpoints.exists() {
+        if !overwrite {
+            return Err(OutputError::HoldsRun {
+                dir: dir.to_owned(),
+                file: checkpoint_folder::DIR_NAME.to_owned(),
+            });
+        }
+        std::fs::remove_dir_all(&checkpoints).map_err(dir_error)?;
     }
     // Probe that files can be created here before any simulation work starts.
     let probe = dir.join(".isph-write-test");

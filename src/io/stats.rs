@@ -2,8 +2,8 @@
 
 use super::OutputError;
 use crate::simulation::StepStats;
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::fs::{File, OpenOptions};
+use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 pub const FILE_NAME: &str = "stats.csv";
@@ -29,6 +29,24 @@ impl StatsWriter {
         };
         w.line(format_args!("{HEADER}"))?;
         Ok(w)
+    }
+
+    /// Continues the stats.csv of `dir` after its first `length` bytes (see `end_of_step`):
+    /// the rows after them are cut off first, durably, so a kill at any instant leaves a prefix.
+    pub fn append_at(dir: &Path, length: u64) -> Result<Self, OutputError> {
+        let path = dir.join(FILE_NAME);
+        let err = |source| OutputError::Write {
+            path: path.clone(),
+            source,
+        };
+        let mut file = OpenOptions::new().write(true).open(&path).map_err(err)?;
+        file.set_len(length).map_err(err)?;
+        file.sync_data().map_err(err)?;
+        file.seek(SeekFrom::End(0)).map_err(err)?;
+        Ok(Self {
+            out: BufWriter::new(file),
+            path,
+        })
     }
 
     fn line(&mut self, args: std::fmt::Arguments) -> Result<(), OutputError> {
@@ -61,4 +79,61 @@ impl StatsWriter {
             source,
         })
     }
+
+    /// Flushes and fsyncs, so the rows written so far survive a crash (before a checkpoint
+    /// that counts on them).
+    pub fn sync(&mut self) -> Result<(), OutputError> {
+        self.flush()?;
+        self.out
+            .get_ref()
+            .sync_data()
+            .map_err(|source| OutputError::Write {
+                path: self.path.clone(),
+                source,
+            })
+    }
+}
+
+/// Length in bytes of the stats.csv of `dir` up to and including the row of `step` (the header
+/// alone for step 0). Refuses a file with another header or without that row.
+pub fn end_of_step(dir: &Path, step: u64) -> Result<u64, OutputError> {
+    let path = dir.join(FILE_NAME);
+    let text = std::fs::read(&path).map_err(|source| OutputError::Read {
+        path: path.clone(),
+        source,
+    })?;
+    let mismatch = |what: String| OutputError::Mismatch {
+        path: path.clone(),
+        what,
+    };
+    // A row cut short by a kill can only be the last line: only complete lines count.
+    let mut lines = text
+        .split_inclusive(|&b| b == b'\n')
+        .filter(|l| l.ends_with(b"\n"));
+    let header = lines.next().unwrap_or_default();
+    if header != format!("{HEADER}\n").as_bytes() {
+        return Err(mismatch(format!(
+            "its first line is `{}`, not the header `{HEADER}` this isph writes",
+            String::from_utf8_lossy(header).trim_end()
+        )));
+    }
+    let mut end = header.len() as u64;
+    let mut last = 0;
+    if step == 0 {
+        return Ok(end);
+    }
+    for line in lines {
+        end += line.len() as u64;
+        let row_step = std::str::from_utf8(line)
+            .ok()
+            .and_then(|l| l.split(',').next())
+            .and_then(|s| s.parse::<u64>().ok());
+        if row_step == Some(step) {
+            return Ok(end);
+        }
+        last = row_step.unwrap_or(last);
+    }
+    Err(mismatch(format!(
+        "it has no row for the checkpoint's step {step} (its last complete row is step {last})"
+    )))
 }

@@ -1,0 +1,214 @@
+//! What `isph resume` checks before a run continues, and how the output directory is cut back to
+//! the checkpoint. Every check comes before the first change to a file, so a refused resume
+//! leaves the directory byte for byte as it was.
+
+use crate::io::checkpoint::{Checkpoint, CheckpointError};
+use crate::io::checkpoint_folder::{self, DIR_NAME};
+use crate::io::frames::{self, FrameWriter};
+use crate::io::stats::{self, StatsWriter};
+use crate::io::{xdmf, OutputError};
+use crate::run::{Output, RunError, StopSignal};
+use crate::scene::{Scene, SceneError};
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug)]
+pub struct ResumeOptions {
+    /// Simulated time to stop at (default: the scene's `end_time`).
+    pub until: Option<f64>,
+    /// Continue even if the scene has changed since the checkpoint was written.
+    pub force: bool,
+    /// The scene file to use instead of the one the checkpoint names.
+    pub scene: Option<PathBuf>,
+    /// No progress display.
+    pub quiet: bool,
+    pub stop: StopSignal,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ResumeError {
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    #[error("cannot read the checkpoints in {dir}: {source}")]
+    Folder {
+        dir: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{dir} holds no checkpoint (files {DIR_NAME}/step_*.ckpt of a run's output directory); a run writes one at its end, on SIGINT/SIGTERM and as `[checkpoint]` in the scene asks")]
+    NoCheckpoint { dir: PathBuf },
+    #[error("{dir} holds no valid checkpoint: {}", reasons.join("; "))]
+    NoValidCheckpoint { dir: PathBuf, reasons: Vec<String> },
+    #[error("{path} is not in the `{DIR_NAME}` folder of a run's output directory, so the run it continues cannot be found; move it back to OUT/{DIR_NAME}/")]
+    OutsideRun { path: PathBuf },
+    #[error("cannot load the scene of checkpoint {checkpoint}: {source}; pass --scene FILE if the scene has moved")]
+    Scene {
+        checkpoint: PathBuf,
+        source: SceneError,
+    },
+    #[error("{scene} has changed since {checkpoint} was written (the scene's hash is {now:#018x}, the checkpoint's {then:#018x}): a continuation would not be the run that was checkpointed. Restore the scene, or pass --force to continue with the scene as it is now")]
+    SceneChanged {
+        checkpoint: PathBuf,
+        scene: PathBuf,
+        now: u64,
+        then: u64,
+    },
+    #[error("{checkpoint} holds a {then}D run but the scene {scene} is {now}D; no --force can continue it")]
+    Dimensions {
+        checkpoint: PathBuf,
+        scene: PathBuf,
+        now: usize,
+        then: usize,
+    },
+    #[error("{checkpoint} is already at t = {time} s, not before the stop time {end} s; pass --until with a later time (or raise `end_time` in the scene)")]
+    NothingToDo {
+        checkpoint: PathBuf,
+        time: f64,
+        end: f64,
+    },
+}
+
+/// The checkpoint `isph resume` continues from, and the newer ones it had to pass over.
+pub struct Located {
+    pub checkpoint: Checkpoint,
+    pub skipped: Vec<CheckpointError>,
+}
+
+/// A checkpoint file as given; or, for a run's output directory or its checkpoints folder, the
+/// newest checkpoint in it that passes every check.
+pub fn locate(target: &Path) -> Result<Located, ResumeError> {
+    if !target.is_dir() {
+        return Ok(Located {
+            checkpoint: Checkpoint::open(target)?,
+            skipped: Vec::new(),
+        });
+    }
+    let dir = if target.file_name().is_some_and(|n| n == DIR_NAME) {
+        target.to_owned()
+    } else {
+        checkpoint_folder::folder(target)
+    };
+    let newest = checkpoint_folder::newest_valid(&dir).map_err(|source| ResumeError::Folder {
+        dir: dir.clone(),
+        source,
+    })?;
+    match newest.valid {
+        Some(checkpoint) => Ok(Located {
+            checkpoint,
+            skipped: newest.rejected,
+        }),
+        None if newest.rejected.is_empty() => Err(ResumeError::NoCheckpoint {
+            dir: target.to_owned(),
+        }),
+        None => Err(ResumeError::NoValidCheckpoint {
+            dir: target.to_owned(),
+            reasons: newest.rejected.iter().map(|e| e.to_string()).collect(),
+        }),
+    }
+}
+
+/// A continued run, ready to step: the scene, and its output cut back to the checkpoint and
+/// open for appending.
+pub(crate) struct Continuation {
+    pub scene: Scene,
+    pub output: Output,
+}
+
+/// Checks that `checkpoint` can be continued (its scene unchanged unless `force`, its run's
+/// frames and rows all there, a stop time after it), then cuts the run back to it: the
+/// checkpoints, frames and stats.csv rows after it are deleted, particles.xdmf is rewritten.
+pub(crate) fn prepare(
+    checkpoint: &Checkpoint,
+    opts: &ResumeOptions,
+) -> Result<Continuation, RunError> {
+    let state = &checkpoint.state;
+    let path = checkpoint.path().to_owned();
+    let out = output_dir(&path)?;
+    let scene = load_scene(checkpoint, opts)?;
+    let end = opts.until.unwrap_or(scene.end_time);
+    if end <= state.time {
+        return Err(ResumeError::NothingToDo {
+            checkpoint: path,
+            time: state.time,
+            end,
+        }
+        .into());
+    }
+    let frames = frames::read_index(&out, state.frames_written as usize)?;
+    if let Some(last) = frames.last().filter(|f| f.time > state.time) {
+        return Err(OutputError::Mismatch {
+            path: out.join(frames::FILE_NAME),
+            what: format!(
+                "its frame {} at t = {} s lies after the checkpoint's t = {} s",
+                last.group, last.time, state.time
+            ),
+        }
+        .into());
+    }
+    let stats_length = stats::end_of_step(&out, state.step)?;
+
+    // Every check has passed: from here on the run's future after the checkpoint is replaced.
+    // particles.h5 is opened for writing first, so that if another program holds it, nothing
+    // has changed yet.
+    let frames_out = FrameWriter::open(&out)?;
+    let folder = checkpoint_folder::folder(&out);
+    checkpoint_folder::remove_after(&folder, state.step).map_err(|source| OutputError::Write {
+        path: folder.clone(),
+        source,
+    })?;
+    let stats = StatsWriter::append_at(&out, stats_length)?;
+    frames_out.remove_frames_from(frames.len())?;
+    xdmf::write(&out, &frames)?;
+    Ok(Continuation {
+        scene,
+        output: Output {
+            dir: out,
+            frames_out,
+            stats,
+            frames,
+        },
+    })
+}
+
+/// OUT for a checkpoint at OUT/checkpoints/step_….ckpt.
+fn output_dir(checkpoint: &Path) -> Result<PathBuf, ResumeError> {
+    let absolute = std::path::absolute(checkpoint).unwrap_or_else(|_| checkpoint.to_owned());
+    let folder = absolute
+        .parent()
+        .filter(|f| f.file_name().is_some_and(|n| n == DIR_NAME));
+    folder
+        .and_then(Path::parent)
+        .map(Path::to_owned)
+        .ok_or_else(|| ResumeError::OutsideRun {
+            path: checkpoint.to_owned(),
+        })
+}
+
+/// The scene the checkpoint names (or `--scene`), refused if it no longer describes the same
+/// run: another dimension always, another content hash unless `--force`.
+fn load_scene(checkpoint: &Checkpoint, opts: &ResumeOptions) -> Result<Scene, ResumeError> {
+    let path = opts
+        .scene
+        .clone()
+        .unwrap_or_else(|| checkpoint.state.scene_path.clone());
+    let scene = Scene::load(&path).map_err(|source| ResumeError::Scene {
+        checkpoint: checkpoint.path().to_owned(),
+        source,
+    })?;
+    if scene.dimensions != checkpoint.dimensions() {
+        return Err(ResumeError::Dimensions {
+            checkpoint: checkpoint.path().to_owned(),
+            scene: path,
+            now: scene.dimensions,
+            then: checkpoint.dimensions(),
+        });
+    }
+    let (now, then) = (scene.content_hash(), checkpoint.state.scene_hash);
+    if now != then && !opts.force {
+        return Err(ResumeError::SceneChanged {
+            checkpoint: checkpoint.path().to_owned(),
+            scene: path,
+            now,
+            then,
+        });
+    }
+    Ok(scene)
+}

@@ -1,0 +1,558 @@
+//! Checkpoint and restart: a continued run is bit-identical to one never stopped, in 2D and 3D;
+//! a damaged checkpoint or a changed scene is refused with every file left as it was; SIGTERM
+//! stops a run with a checkpoint it resumes from.
+
+use crate::common::{isph_command, TempDir};
+use isph::io::checkpoint::Checkpoint;
+use isph::io::checkpoint_folder;
+use isph::particles::{ArrayMut, Kind, Particles};
+use isph::resume::{self, ResumeOptions};
+use isph::run::{self, RunError, RunOptions, StopSignal};
+use isph::scene::Scene;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use std::sync::atomic::Ordering;
+
+/// A shipped scene made coarse and short, writing checkpoints every `every` simulated seconds.
+fn scene_file(
+    dir: &Path,
+    shipped: &str,
+    edits: &[(&str, &str)],
+    every: f64,
+    keep: usize,
+) -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(shipped);
+    let mut text = std::fs::read_to_string(path).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "`{from}` not in {shipped}");
+        text = text.replace(from, to);
+    }
+    text += &format!("\n[checkpoint]\ninterval = {every}\nkeep = {keep}\n");
+    let file = dir.join(shipped);
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+/// 2D dam break at 2 dx: 40 steps to 16 output intervals.
+fn dam_break_2d(dir: &Path) -> PathBuf {
+    let edits = [
+        ("spacing = 0.001905", "spacing = 0.00381"),
+        ("output_interval = 0.01", "output_interval = 0.005"),
+    ];
+    scene_file(dir, "dam_break_2d.toml", &edits, 0.01, 3)
+}
+
+fn run_options(out: &Path, until: f64) -> RunOptions {
+    RunOptions {
+        out: out.to_owned(),
+        until: Some(until),
+        overwrite: false,
+        quiet: true,
+        stop: StopSignal::default(),
+    }
+}
+
+fn resume_options(until: f64) -> ResumeOptions {
+    ResumeOptions {
+        until: Some(until),
+        force: false,
+        scene: None,
+        quiet: true,
+        stop: StopSignal::default(),
+    }
+}
+
+/// Resumes the newest valid checkpoint of `target` (a file or a directory) until `until`.
+fn resume_until(target: &Path, until: f64) -> run::RunSummary {
+    let located = resume::locate(target).unwrap_or_else(|e| panic!("{e}"));
+    run::resume(&located.checkpoint, &resume_options(until)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Every file under `dir` with its bytes.
+fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut files = BTreeMap::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            files.extend(snapshot(&path));
+        } else {
+            files.insert(path.clone(), std::fs::read(&path).unwrap());
+        }
+    }
+    files
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let path = entry.unwrap().path();
+        let target = to.join(path.file_name().unwrap());
+        if path.is_dir() {
+            copy_dir(&path, &target);
+        } else {
+            std::fs::copy(&path, &target).unwrap();
+        }
+    }
+}
+
+/// Every dataset and attribute of every frame of two runs' particles.h5, compared bit for bit.
+fn assert_same_frames(a: &Path, b: &Path, what: &str) {
+    let open = |dir: &Path| hdf5::File::open(dir.join("particles.h5")).unwrap();
+    let (fa, fb) = (open(a), open(b));
+    let (mut names_a, mut names_b) = (fa.member_names().unwrap(), fb.member_names().unwrap());
+    names_a.sort();
+    names_b.sort();
+    assert_eq!(names_a, names_b, "{what}: the frames differ");
+    for frame in &names_a {
+        let (ga, gb) = (fa.group(frame).unwrap(), fb.group(frame).unwrap());
+        for attr in ["time", "step"] {
+            let x: f64 = ga.attr(attr).unwrap().read_scalar::<f64>().unwrap();
+            let y: f64 = gb.attr(attr).unwrap().read_scalar::<f64>().unwrap();
+            assert_eq!(x.to_bits(), y.to_bits(), "{what}: {frame} `{attr}` differs");
+        }
+        for name in ["position", "velocity", "pressure", "density"] {
+            let x = ga.dataset(name).unwrap().read_raw::<f64>().unwrap();
+            let y = gb.dataset(name).unwrap().read_raw::<f64>().unwrap();
+            let same =
+                x.len() == y.len() && x.iter().zip(&y).all(|(x, y)| x.to_bits() == y.to_bits());
+            assert!(same, "{what}: {frame} `{name}` differs");
+        }
+        for name in ["kind", "fluid", "free_surface", "body", "id"] {
+            let x = ga.dataset(name).unwrap().read_raw::<i64>().unwrap();
+            let y = gb.dataset(name).unwrap().read_raw::<i64>().unwrap();
+            assert_eq!(x, y, "{what}: {frame} `{name}` differs");
+        }
+    }
+}
+
+/// stats.csv of two runs, equal in every column but the wall-clock time.
+fn assert_same_stats(a: &Path, b: &Path, what: &str) {
+    let rows = |dir: &Path| -> Vec<String> {
+        std::fs::read_to_string(dir.join("stats.csv"))
+            .unwrap()
+            .lines()
+            .map(|l| l.rsplit_once(',').unwrap().0.to_owned())
+            .collect()
+    };
+    assert_eq!(rows(a), rows(b), "{what}: stats.csv differs");
+}
+
+/// The state of a run's newest checkpoint: step, time and every particle array in memory order.
+fn final_state<const D: usize>(out: &Path) -> (u64, u64, Particles<D>) {
+    let all = checkpoint_folder::list(&checkpoint_folder::folder(out)).unwrap();
+    let checkpoint = Checkpoint::open(&all.last().unwrap().1).unwrap();
+    let mut p = Particles::<D>::default();
+    checkpoint.restore(&mut p).unwrap();
+    (checkpoint.state.step, checkpoint.state.time.to_bits(), p)
+}
+
+fn assert_same_final_state<const D: usize>(a: &Path, b: &Path, what: &str) {
+    let (step_a, time_a, mut pa) = final_state::<D>(a);
+    let (step_b, time_b, mut pb) = final_state::<D>(b);
+    assert_eq!(
+        (step_a, time_a),
+        (step_b, time_b),
+        "{what}: the final step or time differs"
+    );
+    for ((name, x), (_, y)) in pa.arrays_mut().into_iter().zip(pb.arrays_mut()) {
+        let same = match (x, y) {
+            (ArrayMut::F64(x), ArrayMut::F64(y)) => {
+                x.len() == y.len()
+                    && x.iter()
+                        .zip(y.iter())
+                        .all(|(x, y)| x.to_bits() == y.to_bits())
+            }
+            (ArrayMut::U64(x), ArrayMut::U64(y)) => x == y,
+            (ArrayMut::U16(x), ArrayMut::U16(y)) => x == y,
+            (ArrayMut::U8(x), ArrayMut::U8(y)) => x == y,
+            (ArrayMut::Kind(x), ArrayMut::Kind(y)) => x == y,
+            _ => false,
+        };
+        assert!(same, "{what}: the final `{name}` differs");
+    }
+}
+
+fn assert_same_run<const D: usize>(whole: &Path, other: &Path, what: &str) {
+    assert_same_frames(whole, other, what);
+    assert_same_stats(whole, other, what);
+    assert_same_final_state::<D>(whole, other, what);
+}
+
+#[test]
+fn a_continued_2d_run_is_bit_identical_to_one_never_stopped() {
+    let dir = TempDir::new("ckpt-2d");
+    let scene = Scene::load(&dam_break_2d(dir.path())).unwrap();
+    let (half, end) = (8.0 * scene.output_interval, 16.0 * scene.output_interval);
+    let whole = dir.path().join("whole");
+    run::run(&scene, &run_options(&whole, end)).unwrap();
+    // `keep = 3` of the checkpoints written every 0.01 s and at the end.
+    assert_eq!(
+        checkpoint_folder::list(&checkpoint_folder::folder(&whole))
+            .unwrap()
+            .len(),
+        3
+    );
+
+    // Stopped at T/2, continued to T.
+    let split = dir.path().join("split");
+    run::run(&scene, &run_options(&split, half)).unwrap();
+    let summary = resume_until(&split, end);
+    assert!(summary.steps > 10, "only {} steps after T/2", summary.steps);
+    assert_same_run::<2>(&whole, &split, "stopped at T/2");
+
+    // Stopped by a signal after its first step (between two frames), continued to T.
+    let signalled = dir.path().join("signalled");
+    let opts = run_options(&signalled, end);
+    opts.stop.store(15, Ordering::Relaxed);
+    match run::run(&scene, &opts) {
+        Err(RunError::Interrupted { saved, .. }) => assert_eq!(saved.step, 1),
+        other => panic!("not interrupted: {other:?}"),
+    }
+    resume_until(&signalled, end);
+    assert_same_run::<2>(&whole, &signalled, "stopped by a signal");
+
+    // A run that went on to T, resumed from an older checkpoint: the frames, rows and
+    // checkpoints after that checkpoint are replaced.
+    let rewound = dir.path().join("rewound");
+    copy_dir(&whole, &rewound);
+    let (oldest_step, oldest) = checkpoint_folder::list(&checkpoint_folder::folder(&rewound))
+        .unwrap()
+        .remove(0);
+    let before: Vec<f64> = crate::common::stats_column(&rewound, "step");
+    assert!(before.len() as u64 > oldest_step);
+    resume_until(&oldest, end);
+    assert_same_run::<2>(&whole, &rewound, "rewound to an older checkpoint");
+}
+
+#[test]
+fn a_continued_3d_run_is_bit_identical_to_one_never_stopped() {
+    let dir = TempDir::new("ckpt-3d");
+    let edits = [("spacing = 0.02", "spacing = 0.04")];
+    let scene = Scene::load(&scene_file(
+        dir.path(),
+        "dam_break_3d.toml",
+        &edits,
+        0.04,
+        2,
+    ))
+    .unwrap();
+    let (half, end) = (3.0 * scene.output_interval, 6.0 * scene.output_interval);
+    let whole = dir.path().join("whole");
+    run::run(&scene, &run_options(&whole, end)).unwrap();
+    let split = dir.path().join("split");
+    run::run(&scene, &run_options(&split, half)).unwrap();
+    let summary = resume_until(&split.join("checkpoints"), end);
+    assert!(summary.steps > 5, "only {} steps after T/2", summary.steps);
+    assert_same_run::<3>(&whole, &split, "3D stopped at T/2");
+}
+
+fn isph(args: &[&str]) -> Output {
+    isph_command().args(args).output().unwrap()
+}
+
+fn assert_refused(o: &Output, expected: &[&str]) {
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_ne!(o.status.code(), Some(0), "accepted; stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for e in expected {
+        assert!(stderr.contains(e), "`{e}` missing from: {stderr}");
+    }
+}
+
+/// A short 2D run in `dir/base` whose checkpoints every run of the refusal test starts from.
+fn base_run(dir: &Path) -> PathBuf {
+    let edits = [
+        ("spacing = 0.001905", "spacing = 0.00762"),
+        ("output_interval = 0.01", "output_interval = 0.005"),
+    ];
+    let scene = scene_file(dir, "dam_break_2d.toml", &edits, 0.005, 3);
+    let out = dir.join("base");
+    let o = isph(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--until",
+        "0.02",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
+fn newest_checkpoint(out: &Path) -> PathBuf {
+    let all = checkpoint_folder::list(&checkpoint_folder::folder(out)).unwrap();
+    all.last().unwrap().1.clone()
+}
+
+/// Damages the newest checkpoint of a copy of `base` and resumes it: refused with `expected`
+/// in the message, and no file of the run changed.
+fn assert_damage_refused(
+    base: &Path,
+    copy: &Path,
+    damage: impl Fn(&mut Vec<u8>),
+    expected: &[&str],
+) {
+    copy_dir(base, copy);
+    let newest = newest_checkpoint(copy);
+    let mut bytes = std::fs::read(&newest).unwrap();
+    damage(&mut bytes);
+    std::fs::write(&newest, bytes).unwrap();
+    let before = snapshot(copy);
+    let o = isph(&["resume", newest.to_str().unwrap(), "--until", "0.04", "-q"]);
+    assert_refused(&o, expected);
+    assert!(
+        snapshot(copy) == before,
+        "a refused resume changed the run's files"
+    );
+}
+
+#[test]
+fn damaged_checkpoints_and_changed_scenes_are_refused_and_nothing_changes() {
+    let dir = TempDir::new("ckpt-refusals");
+    let base = base_run(dir.path());
+    let case = |name: &str| dir.path().join(name);
+
+    assert_damage_refused(
+        &base,
+        &case("truncated"),
+        |b| b.truncate(b.len() - 100),
+        &["is truncated", "holds"],
+    );
+    assert_damage_refused(
+        &base,
+        &case("checksum"),
+        |b| {
+            let k = b.len() / 2;
+            b[k] ^= 1;
+        },
+        &["checksum", "damaged"],
+    );
+    assert_damage_refused(
+        &base,
+        &case("magic"),
+        |b| b[..8].copy_from_slice(b"HDF5\0\0\0\0"),
+        &["not an isph checkpoint"],
+    );
+    assert_damage_refused(
+        &base,
+        &case("version"),
+        |b| b[8..12].copy_from_slice(&99u32.to_ne_bytes()),
+        &["format version 99", "newer"],
+    );
+
+    // The scene changed: refused, unless --force.
+    let changed = case("changed");
+    copy_dir(&base, &changed);
+    let scene = dir.path().join("dam_break_2d.toml");
+    let original = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(
+        &scene,
+        original.replace("viscosity = 1.0e-6", "viscosity = 2.0e-6"),
+    )
+    .unwrap();
+    let before = snapshot(&changed);
+    let o = isph(&["resume", changed.to_str().unwrap(), "--until", "0.04", "-q"]);
+    assert_refused(&o, &["has changed", "--force", "dam_break_2d.toml"]);
+    assert!(
+        snapshot(&changed) == before,
+        "a refused resume changed the run's files"
+    );
+    let o = isph(&[
+        "resume",
+        changed.to_str().unwrap(),
+        "--until",
+        "0.04",
+        "-q",
+        "--force",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Comments and the end time do not count as a change.
+    std::fs::write(
+        &scene,
+        format!(
+            "# a comment\n{}",
+            original.replace("end_time = 1.0", "end_time = 2.0")
+        ),
+    )
+    .unwrap();
+    let o = isph(&["resume", base.to_str().unwrap(), "--until", "0.03", "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn a_directory_resumes_from_its_newest_valid_checkpoint() {
+    let dir = TempDir::new("ckpt-newest");
+    let base = base_run(dir.path());
+    let all = checkpoint_folder::list(&checkpoint_folder::folder(&base)).unwrap();
+    assert!(all.len() >= 2);
+    let (newest, older) = (&all[all.len() - 1].1, &all[all.len() - 2]);
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(newest)
+        .unwrap()
+        .set_len(1000)
+        .unwrap();
+    let o = isph(&["resume", base.to_str().unwrap(), "--until", "0.03", "-q"]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("skipped") && stderr.contains("truncated"),
+        "{stderr}"
+    );
+    assert!(
+        stdout.contains(&format!(
+            "resumed {} at step {}",
+            older.1.display(),
+            older.0
+        )),
+        "{stdout}"
+    );
+
+    // With every checkpoint damaged, nothing is resumed and nothing changes.
+    for (_, path) in checkpoint_folder::list(&checkpoint_folder::folder(&base)).unwrap() {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .unwrap()
+            .set_len(50)
+            .unwrap();
+    }
+    let before = snapshot(&base);
+    let o = isph(&["resume", base.to_str().unwrap(), "--until", "0.04", "-q"]);
+    assert_refused(&o, &["no valid checkpoint", "truncated"]);
+    assert!(
+        snapshot(&base) == before,
+        "a refused resume changed the run's files"
+    );
+}
+
+#[test]
+fn sigterm_stops_a_run_with_a_checkpoint_it_resumes_from() {
+    let dir = TempDir::new("ckpt-sigterm");
+    let scene = dam_break_2d(dir.path());
+    let out = dir.path().join("out");
+    let child = isph_command()
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait for the run to be under way: its first periodic checkpoint (t = 0.01 s).
+    let started = std::time::Instant::now();
+    while checkpoint_folder::list(&checkpoint_folder::folder(&out)).map_or(true, |l| l.is_empty()) {
+        assert!(started.elapsed().as_secs() < 60, "no checkpoint after 60 s");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // SAFETY: a signal to the child this test started and has not yet waited for.
+    let sent = unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    assert_eq!(sent, 0, "kill failed");
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(128 + 15), "{stderr}");
+    assert!(
+        stderr.contains("stopped by SIGTERM") && stderr.contains("isph resume"),
+        "{stderr}"
+    );
+    let steps = crate::common::stats_column(&out, "step");
+    let newest = newest_checkpoint(&out);
+    let state = &Checkpoint::open(&newest).unwrap().state;
+    assert_eq!(
+        state.step as f64,
+        *steps.last().unwrap(),
+        "the checkpoint is not at the last step"
+    );
+    let o = isph(&[
+        "resume",
+        out.to_str().unwrap(),
+        "--until",
+        &(state.time + 0.005).to_string(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn a_numerical_failure_names_the_newest_checkpoint() {
+    let dir = TempDir::new("ckpt-failure");
+    let scene = Scene::load(&dam_break_2d(dir.path())).unwrap();
+    let out = dir.path().join("out");
+    run::run(&scene, &run_options(&out, 2.0 * scene.output_interval)).unwrap();
+    // The newest checkpoint, rewritten with a fluid particle far outside the domain: the next
+    // step finds it there.
+    let newest = newest_checkpoint(&out);
+    let checkpoint = Checkpoint::open(&newest).unwrap();
+    let mut p = Particles::<2>::default();
+    checkpoint.restore(&mut p).unwrap();
+    let fluid = p.kind.iter().position(|&k| k == Kind::Fluid).unwrap();
+    p.pos[0][fluid] = 1.0e3;
+    let folder = checkpoint_folder::folder(&out);
+    checkpoint_folder::save(&folder, &checkpoint.state, &mut p, 3).unwrap();
+    let rows = crate::common::stats_column(&out, "step").len();
+
+    let located = resume::locate(&out).unwrap();
+    let e = run::resume(&located.checkpoint, &resume_options(0.1)).unwrap_err();
+    let message = e.to_string();
+    match e {
+        RunError::Numerical {
+            last_checkpoint, ..
+        } => {
+            let saved = last_checkpoint.expect("no checkpoint named");
+            assert_eq!((saved.step, &saved.path), (checkpoint.state.step, &newest));
+        }
+        other => panic!("not a numerical failure: {other}"),
+    }
+    assert!(
+        message.contains("left the domain") && message.contains("isph resume"),
+        "{message}"
+    );
+    assert_eq!(
+        crate::common::stats_column(&out, "step").len(),
+        rows,
+        "rows written after the failure"
+    );
+    assert_eq!(
+        newest_checkpoint(&out),
+        newest,
+        "a checkpoint was written after the failure"
+    );
+}
+
+#[test]
+fn bad_checkpoint_sections_are_refused_with_key_and_line() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hydrostatic_2d.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines = text.lines().count();
+    let cases: &[(&str, &[&str])] = &[
+        ("interval = -0.5", &["checkpoint.interval", "positive"]),
+        (
+            "wall_interval = 0.0",
+            &["checkpoint.wall_interval", "positive"],
+        ),
+        ("keep = 0", &["checkpoint.keep", "at least 1"]),
+        ("every = 3", &["unknown field `every`"]),
+    ];
+    for (section, expected) in cases {
+        let bad = format!("{text}\n[checkpoint]\n{section}\n");
+        let e = Scene::parse(&bad, &path).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!(":{}", lines + 3)) || e.contains(&format!("line {}", lines + 3)),
+            "no line in: {e}"
+        );
+        for x in *expected {
+            assert!(e.contains(x), "`{x}` missing from: {e}");
+        }
+    }
+}
