@@ -78,7 +78,7 @@ impl<const D: usize> Support<D> {
         if self.is_splash() || density_ratio < SPRAY_DENSITY {
             return true;
         }
-        if self.lambda > INTERIOR_EIGENVALUE && std::env::var("ISPH_SCAN_ALL").is_err() {
+        if self.lambda > INTERIOR_EIGENVALUE {
             return false;
         }
         let directions = [self.normal, self.axis, self.axis.map(|v| -v)];

@@ -112,7 +112,9 @@ pub fn row_vectors<const D: usize>(
             let n = contact_line_normal(nb, p, supports[i].normal, spacing, i);
             let delta = 0.5 * spacing;
             match &pressure_corrections[i] {
-                Some(l) => std::array::from_fn(|a| delta * (0..D).map(|b| l[b][a] * n[b]).sum::<f64>()),
+                Some(l) => {
+                    std::array::from_fn(|a| delta * (0..D).map(|b| l[b][a] * n[b]).sum::<f64>())
+                }
                 None => n.map(|x| delta * x),
             }
         }
@@ -288,7 +290,9 @@ impl<const D: usize> PressureOperator<'_, D> {
     fn interior_coefficient(&self, i: usize, j: usize, rij: [f64; D], r: f64) -> f64 {
         let (nb, p) = (self.nb, self.p);
         let coefficient = laplacian_coefficient(nb, p, i, j, r)
-            - p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * self.row_vector_dot(i, rij);
+            - p.mass[j] / p.rest_density[j]
+                * nb.kernel.grad_factor(r)
+                * self.row_vector_dot(i, rij);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.

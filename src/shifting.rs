@@ -38,7 +38,7 @@ impl Shifting {
     /// Shifting for a step of `dt` with largest fluid speed `max_speed` at spacing `spacing`.
     pub fn new<const D: usize>(nb: &Neighbours<D>, spacing: f64, max_speed: f64, dt: f64) -> Self {
         Self {
-            diffusion: std::env::var("ISPH_A").map(|v| v.parse::<f64>().unwrap()).unwrap_or(DIFFUSION_NUMBER) * nb.kernel.h() * max_speed * dt,
+            diffusion: DIFFUSION_NUMBER * nb.kernel.h() * max_speed * dt,
             w_dx: nb.kernel.w(spacing),
             cap: MAX_SHIFT * spacing,
         }

@@ -185,7 +185,8 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// Largest stable Δt: CFL, viscous and body-force limits. A CFL step far below the
-    /// body-force step means the flow has blown up: that is reported, not integrated.
+    /// body-force step means the flow has blown up: that is reported, not integrated (without
+    /// gravity there is no such reference, and only a non-finite velocity stops the run).
     pub fn time_step_limit(&self) -> Result<f64, NumericalFailure> {
         let p = &self.particles;
         let h = self.kernel.h();
@@ -195,7 +196,7 @@ impl<const D: usize> Simulation<D> {
         let dt = cfl
             .min(body_force)
             .min(VISCOUS_NUMBER * h * h / self.max_viscosity);
-        if cfl < COLLAPSE_FRACTION * body_force {
+        if body_force.is_finite() && cfl < COLLAPSE_FRACTION * body_force {
             return Err(NumericalFailure::TimeStepCollapse {
                 step: self.step,
                 time: self.time,
@@ -302,25 +303,38 @@ impl<const D: usize> Simulation<D> {
                     Kind::Wall => (None, None, Support::FULL),
                 }
             });
-        ppe::assign_roles(&nb, p, &w.supports, &w.pressure_corrections, gravity, &mut w.roles);
+        ppe::assign_roles(
+            &nb,
+            p,
+            &w.supports,
+            &w.pressure_corrections,
+            gravity,
+            &mut w.roles,
+        );
         ppe::full_support(&nb, &w.roles, &mut w.full_support);
         fill(&mut p.free_surface, |i| match w.roles[i] {
             Role::Surface => 1,
             Role::Splash => 2,
             Role::Interior | Role::Wall => 0,
         });
-        if std::env::var("ISPH_DEBUG").is_ok() && self.step % 20 == 0 {
-            for i in 0..p.len() {
-                if p.is_fluid(i) && p.pos[1][i] > 0.46 && (p.pos[0][i] < 0.05) {
-                    eprintln!("{:?} {:?} lambda {:.3} rho {:.3} P {:.2}", p.position(i), w.roles[i], w.supports[i].lambda, p.density[i]/1000.0, p.pressure[i]);
+        // Inside the fluid (no free surface in reach) the moment matrix measures the disorder of
+        // the particles, not a truncated support: corrected there, the divergence of the PPE
+        // source amplifies that disorder into the pressure (measured: a collision of two blocks
+        // gains energy instead of losing it). The pressure gradient keeps its correction, which
+        // there corrects the wall ghosts' missing tangential gradient.
+        w.corrections
+            .par_iter_mut()
+            .zip(&w.full_support)
+            .for_each(|(l, &full)| {
+                if full {
+                    *l = None;
                 }
-            }
-        }
+            });
         let (corrections, pressure_corrections) = (&w.corrections, &w.pressure_corrections);
 
         // Smagorinsky eddy viscosity, Eq. (3)–(4).
         w.eddy.resize(p.len(), 0.0);
-        let cs_delta = if std::env::var("ISPH_NO_LES").is_ok() { 0.0 } else { SMAGORINSKY * self.spacing };
+        let cs_delta = SMAGORINSKY * self.spacing;
         fill(&mut w.eddy, |i| match p.kind[i] {
             Kind::Fluid if cs_delta > 0.0 => {
                 sph::eddy_viscosity(&nb, p, &corrections[i], cs_delta, i)
@@ -387,6 +401,7 @@ impl<const D: usize> Simulation<D> {
 
         // Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the
         // walls as ghosts; particles touching a wall then keep no velocity into it.
+        let full = &w.full_support;
         let mut vel = std::mem::replace(&mut p.vel, components());
         fill_vector(&mut vel, |i| match p.kind[i] {
             Kind::Fluid => {
@@ -400,7 +415,6 @@ impl<const D: usize> Simulation<D> {
         p.vel = vel;
 
         // Density error where the summation density is not truncated by the free surface.
-        let full = &w.full_support;
         let n_full = full.iter().filter(|&&f| f).count();
         let density_error = if n_full == 0 {
             0.0
@@ -417,7 +431,7 @@ impl<const D: usize> Simulation<D> {
         // Particle shifting δr = −D ∇C (Eq. 10) at rⁿ, then velocity and pressure carried to
         // the shifted position by Eq. (9).
         let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
-        let shifting = Shifting::new(&nb, self.spacing, if std::env::var("ISPH_NO_SHIFT").is_ok() { 0.0 } else { max_speed }, dt);
+        let shifting = Shifting::new(&nb, self.spacing, max_speed, dt);
         fill_vector(&mut w.shift, |i| match w.roles[i] {
             // Splashes are left in place: neither ∇C nor the Taylor correction means anything
             // there.
@@ -431,9 +445,17 @@ impl<const D: usize> Simulation<D> {
         let shift_of = |i: usize| -> [f64; D] { std::array::from_fn(|d| shift[d][i]) };
         fill_vector(&mut w.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
-                let g =
-                    sph::velocity_gradient(&nb, p, &corrections[i], |j| sph::fluid_velocity(p, i, j), i);
-                let dr = shift_of(i);
+                let g = sph::velocity_gradient(
+                    &nb,
+                    p,
+                    &corrections[i],
+                    |j| sph::fluid_velocity(p, i, j),
+                    i,
+                );
+                // Where the free surface is in reach the velocity gradient is no longer that of
+                // a filled support, and shifting moves particles into the thinning, faster parts
+                // of a stretching flow: the Taylor step there feeds the flow energy (measured).
+                let dr = if full[i] { shift_of(i) } else { [0.0; D] };
                 std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
             }
             Kind::Wall => [0.0; D],

@@ -169,7 +169,11 @@ pub struct Moments<const D: usize> {
 }
 
 /// The support moments of particle i.
-pub fn support_moments<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> Moments<D> {
+pub fn support_moments<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> Moments<D> {
     let mut mo = Moments {
         m: [[0.0; D]; D],
         m_neumann: [[0.0; D]; D],
