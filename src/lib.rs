@@ -21,4 +21,5 @@ pub mod scene;
 pub mod shifting;
 pub mod simulation;
 pub mod sph;
+pub mod turbulence;
 pub mod wall;

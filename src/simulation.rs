@@ -12,6 +12,7 @@ use crate::reduce::{self, fill, fill_vector};
 use crate::scene::{Aabb, Scene};
 use crate::shifting::Shifting;
 use crate::sph::{self, Correction, Neighbours};
+use crate::turbulence;
 use crate::wall;
 use rayon::prelude::*;
 
@@ -19,9 +20,6 @@ use rayon::prelude::*;
 const VISCOUS_NUMBER: f64 = 0.125;
 /// Body-force time-step limit Δt ≤ C_g √(h/|g|).
 const BODY_FORCE_NUMBER: f64 = 0.25;
-
-/// Smagorinsky constant Cs of Eq. (3)–(4), Δ = dx.
-const SMAGORINSKY: f64 = 0.2;
 
 /// A CFL time step below this fraction of the body-force step is a blow-up.
 const COLLAPSE_FRACTION: f64 = 1.0e-3;
@@ -334,19 +332,19 @@ impl<const D: usize> Simulation<D> {
 
         // Smagorinsky eddy viscosity, Eq. (3)–(4).
         w.eddy.resize(p.len(), 0.0);
-        let cs_delta = SMAGORINSKY * self.spacing;
+        let spacing = self.spacing;
         fill(&mut w.eddy, |i| match p.kind[i] {
-            Kind::Fluid if cs_delta > 0.0 => {
-                sph::eddy_viscosity(&nb, p, &corrections[i], cs_delta, i)
-            }
-            _ => 0.0,
+            Kind::Fluid => turbulence::eddy_viscosity(&nb, p, &corrections[i], spacing, i),
+            Kind::Wall => 0.0,
         });
 
-        // Predictor, Eq. (5): u* = uⁿ + Δt (∇·((ν + ν_t)∇uⁿ) + g); walls stay at rest.
+        // Predictor, Eq. (5): u* = uⁿ + Δt (∇·((ν + ν_t)∇uⁿ) + τ_w + g), with τ_w the turbulent
+        // wall shear; walls stay at rest.
         fill_vector(&mut w.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
                 let visc = sph::viscous_acceleration(&nb, p, &w.eddy, i);
-                std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + gravity[d]))
+                let wall = turbulence::wall_shear(&nb, p, spacing, i);
+                std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + wall[d] + gravity[d]))
             }
             Kind::Wall => [0.0; D],
         });

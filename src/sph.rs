@@ -62,8 +62,9 @@ pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -
 }
 
 /// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, the eddy viscosity of
-/// the Smagorinsky model (Eq. 3–4). Wall particles are at rest and take the fluid's viscosity
-/// (no-slip).
+/// the Smagorinsky model (Eq. 3–4). Wall particles are at rest (no-slip) and take the fluid's
+/// laminar viscosity: the turbulent stress at a wall is the law of the wall's
+/// (`turbulence::wall_shear`).
 pub fn viscous_acceleration<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
@@ -73,10 +74,9 @@ pub fn viscous_acceleration<const D: usize>(
     let (rho_i, nu_i) = (p.rest_density[i], p.viscosity[i] + eddy[i]);
     let mut acc = [0.0; D];
     nb.for_each(i, |j, _, r| {
-        let nu_j = if p.kind[j] == Kind::Wall {
-            nu_i
-        } else {
-            p.viscosity[j] + eddy[j]
+        let (nu_i, nu_j) = match p.kind[j] {
+            Kind::Wall => (p.viscosity[i], p.viscosity[i]),
+            Kind::Fluid => (nu_i, p.viscosity[j] + eddy[j]),
         };
         let rho_j = p.rest_density[j];
         let c =
@@ -128,26 +128,6 @@ pub fn fluid_velocity<const D: usize>(p: &Particles<D>, i: usize, j: usize) -> [
             ghost_velocity(p, j, u_i, u_i)
         }
     }
-}
-
-/// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S|, |S| = (2 S_ab S_ab)^½, S the strain rate of
-/// the corrected velocity gradient (Eq. 3–4); walls are free-slip ghosts (`fluid_velocity`).
-pub fn eddy_viscosity<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    l: &Correction<D>,
-    cs_delta: f64,
-    i: usize,
-) -> f64 {
-    let grad = velocity_gradient(nb, p, l, |j| fluid_velocity(p, i, j), i);
-    let mut ss = 0.0;
-    for a in 0..D {
-        for b in 0..D {
-            let s = 0.5 * (grad[a][b] + grad[b][a]);
-            ss += s * s;
-        }
-    }
-    cs_delta * cs_delta * (2.0 * ss).sqrt()
 }
 
 /// Smallest determinant of the moment matrix M_i for which the kernel gradient correction is
