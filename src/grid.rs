@@ -12,6 +12,8 @@ pub struct CellList<const D: usize> {
     dims: [usize; D],
     /// Particles of cell c are `cell_start[c]..cell_start[c + 1]` (after `sort`).
     cell_start: Vec<u32>,
+    /// Cell of each particle in the sorted order.
+    sorted_cell: Vec<u32>,
 }
 
 /// A particle outside the grid's box (it has left the domain).
@@ -31,7 +33,19 @@ impl<const D: usize> CellList<D> {
             inv_cell: 1.0 / cell,
             dims,
             cell_start: vec![0; ncells + 1],
+            sorted_cell: Vec::new(),
         }
+    }
+
+    /// Cells per axis, guard cells included (x fastest in the linear index).
+    pub fn dims(&self) -> [usize; D] {
+        self.dims
+    }
+
+    /// The cell of particle k of the sorted order (after `sort`).
+    #[inline]
+    pub fn cell_of_sorted(&self, k: usize) -> usize {
+        self.sorted_cell[k] as usize
     }
 
     pub fn cell_count(&self) -> usize {
@@ -79,9 +93,12 @@ impl<const D: usize> CellList<D> {
             self.cell_start[c + 1] += self.cell_start[c];
         }
         order.resize(n, 0);
+        self.sorted_cell.resize(n, 0);
         let mut next = self.cell_start.clone();
         for (i, &c) in cell_of.iter().enumerate() {
-            order[next[c as usize] as usize] = i as u32;
+            let k = next[c as usize] as usize;
+            order[k] = i as u32;
+            self.sorted_cell[k] = c;
             next[c as usize] += 1;
         }
         Ok(())

@@ -1,6 +1,7 @@
 //! The quintic spline kernel of Eq. (19) (Schoenberg / Morris 1997), support radius 3h.
 
 use std::f64::consts::PI;
+use wide::{f64x4, CmpGt};
 
 /// Support radius in units of the smoothing length h.
 pub const SUPPORT_IN_H: f64 = 3.0;
@@ -62,5 +63,34 @@ impl<const D: usize> Quintic<D> {
             // lim_{r→0} W'(r)/r = W''(0) = α (20 (27 − 6·8 + 15)) / h² (from d²/dq² of Eq. 19 at q = 0)
             self.norm * 20.0 * (27.0 - 48.0 + 15.0) * self.inv_h * self.inv_h
         }
+    }
+
+    /// W(r) in lanes.
+    #[inline(always)]
+    pub fn w4(&self, r: f64x4) -> f64x4 {
+        let [a, b, c] = self.spline_terms4(r);
+        let p5 = |x: f64x4| (x * x) * (x * x) * x;
+        f64x4::splat(self.norm)
+            * f64x4::splat(15.0).mul_add(p5(c), f64x4::splat(-6.0).mul_add(p5(b), p5(a)))
+    }
+
+    /// F(r) = W'(r)/r in lanes (lanes with r = 0 take the limit W''(0)).
+    #[inline(always)]
+    pub fn grad_factor4(&self, r: f64x4) -> f64x4 {
+        let [a, b, c] = self.spline_terms4(r);
+        let p4 = |x: f64x4| (x * x) * (x * x);
+        let dw_dq = f64x4::splat(-5.0)
+            * f64x4::splat(15.0).mul_add(p4(c), f64x4::splat(-6.0).mul_add(p4(b), p4(a)));
+        let at_zero = f64x4::splat(self.grad_factor(0.0));
+        let safe_r = r.max(f64x4::splat(f64::MIN_POSITIVE));
+        let f = f64x4::splat(self.norm * self.inv_h) * dw_dq / safe_r;
+        r.cmp_gt(f64x4::ZERO).blend(f, at_zero)
+    }
+
+    /// (3 − q)₊, (2 − q)₊, (1 − q)₊ with q = r/h.
+    #[inline(always)]
+    fn spline_terms4(&self, r: f64x4) -> [f64x4; 3] {
+        let q = r * f64x4::splat(self.inv_h);
+        [3.0, 2.0, 1.0].map(|k| (f64x4::splat(k) - q).max(f64x4::ZERO))
     }
 }

@@ -1,5 +1,5 @@
-//! Matrix-free Krylov solver: BiCGSTAB (van der Vorst 1992) with right Jacobi
-//! preconditioning, against a small linear-operator trait. It knows nothing of particles.
+//! Matrix-free Krylov solver: BiCGSTAB (van der Vorst 1992) with right preconditioning,
+//! against small linear-operator and preconditioner traits. It knows nothing of particles.
 
 use crate::reduce::{dot, fill};
 use rayon::prelude::*;
@@ -10,6 +10,40 @@ pub trait LinearOperator: Sync {
     fn apply(&self, x: &[f64], y: &mut [f64]);
     /// The diagonal of A (for the Jacobi preconditioner).
     fn diagonal(&self, diag: &mut [f64]);
+}
+
+/// z ≈ A⁻¹ r: a fixed linear map built once per solve from the operator.
+pub trait Preconditioner<A: LinearOperator> {
+    fn setup(&mut self, a: &A) -> Result<(), SolverError>;
+    fn precondition(&mut self, a: &A, r: &[f64], z: &mut [f64]);
+}
+
+/// The Jacobi preconditioner z = D⁻¹ r.
+#[derive(Default)]
+pub struct Jacobi {
+    inv_diag: Vec<f64>,
+}
+
+impl<A: LinearOperator> Preconditioner<A> for Jacobi {
+    fn setup(&mut self, a: &A) -> Result<(), SolverError> {
+        inverse_diagonal(a, &mut self.inv_diag)
+    }
+
+    fn precondition(&mut self, _: &A, r: &[f64], z: &mut [f64]) {
+        let inv = &self.inv_diag;
+        fill(z, |i| inv[i] * r[i]);
+    }
+}
+
+/// 1/a_ii of every row; an error for a zero on the diagonal.
+pub fn inverse_diagonal(a: &impl LinearOperator, inv: &mut Vec<f64>) -> Result<(), SolverError> {
+    inv.resize(a.len(), 0.0);
+    a.diagonal(inv);
+    if let Some(row) = inv.iter().position(|&d| d == 0.0) {
+        return Err(SolverError::ZeroDiagonal { row });
+    }
+    inv.par_iter_mut().for_each(|d| *d = 1.0 / *d);
+    Ok(())
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -31,14 +65,13 @@ pub struct SolveInfo {
 pub enum SolverError {
     #[error("BiCGSTAB produced a non-finite residual after {iterations} iterations")]
     NotFinite { iterations: usize },
-    #[error("a zero on the diagonal at row {row}: the Jacobi preconditioner is undefined")]
+    #[error("a zero on the diagonal at row {row}: the preconditioner is undefined")]
     ZeroDiagonal { row: usize },
 }
 
 /// BiCGSTAB work vectors, allocated once and reused for every solve.
 #[derive(Default)]
 pub struct BiCgStab {
-    inv_diag: Vec<f64>,
     r: Vec<f64>,
     r_hat: Vec<f64>,
     p: Vec<f64>,
@@ -54,12 +87,11 @@ fn norm(a: &[f64]) -> f64 {
 }
 
 impl BiCgStab {
-    /// Bytes held per unknown (nine vectors of f64).
-    pub const BYTES_PER_UNKNOWN: usize = 9 * 8;
+    /// Bytes held per unknown (eight vectors of f64).
+    pub const BYTES_PER_UNKNOWN: usize = 8 * 8;
 
     fn resize(&mut self, n: usize) {
         for v in [
-            &mut self.inv_diag,
             &mut self.r,
             &mut self.r_hat,
             &mut self.p,
@@ -73,21 +105,18 @@ impl BiCgStab {
         }
     }
 
-    /// Solves A x = b starting from the `x` given (warm start).
-    pub fn solve(
+    /// Solves A x = b with preconditioner `m`, starting from the `x` given (warm start).
+    pub fn solve<A: LinearOperator>(
         &mut self,
-        a: &impl LinearOperator,
+        a: &A,
+        m: &mut impl Preconditioner<A>,
         b: &[f64],
         x: &mut [f64],
         params: SolverParams,
     ) -> Result<SolveInfo, SolverError> {
         let n = a.len();
         self.resize(n);
-        a.diagonal(&mut self.inv_diag);
-        if let Some(row) = self.inv_diag.iter().position(|&d| d == 0.0) {
-            return Err(SolverError::ZeroDiagonal { row });
-        }
-        self.inv_diag.par_iter_mut().for_each(|d| *d = 1.0 / *d);
+        m.setup(a)?;
 
         let b_norm = norm(b);
         if b_norm == 0.0 {
@@ -100,7 +129,6 @@ impl BiCgStab {
         }
         let tol = params.tolerance * b_norm;
         let Self {
-            inv_diag,
             r,
             r_hat,
             p,
@@ -134,7 +162,7 @@ impl BiCgStab {
             p.par_iter_mut()
                 .enumerate()
                 .for_each(|(i, p)| *p = r[i] + beta * (*p - omega * v[i]));
-            fill(p_hat, |i| inv_diag[i] * p[i]);
+            m.precondition(a, p, p_hat);
             a.apply(p_hat, v);
             alpha = rho / dot(r_hat, v);
             fill(s, |i| r[i] - alpha * v[i]);
@@ -145,7 +173,7 @@ impl BiCgStab {
                 converged = true;
                 break;
             }
-            fill(s_hat, |i| inv_diag[i] * s[i]);
+            m.precondition(a, s, s_hat);
             a.apply(s_hat, t);
             omega = dot(t, s) / dot(t, t);
             x.par_iter_mut()

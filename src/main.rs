@@ -135,6 +135,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 out.display(),
                 summary.checkpoint.path.display()
             );
+            println!("time per stage: {}", summary.timings);
             Ok(())
         }
         Command::Resume {
@@ -174,6 +175,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 summary.frames.len(),
                 summary.checkpoint.path.display()
             );
+            println!("time per stage: {}", summary.timings);
             Ok(())
         }
         Command::Plan { scene } => {

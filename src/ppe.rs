@@ -15,10 +15,13 @@
 
 use crate::free_surface::Support;
 use crate::linsolve::LinearOperator;
+use crate::multigrid::{cell_offset, stencil_slot, Aggregated};
+use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
-use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Neighbours};
-use crate::wall::{behind_walls, ghost_pressure_difference, ghost_velocity};
+use crate::sph::{velocity_gradient, Correction, Neighbours};
+use crate::wall::{behind_walls, ghost_velocity};
+use wide::{f64x4, CmpNe};
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,26 +169,14 @@ pub fn source<const D: usize>(
 ) {
     let (nb, p) = (op.nb, op.p);
     b.resize(p.len(), 0.0);
-    fill(b, |i| match op.roles[i] {
-        Role::Interior => {
-            let mut walls = 0.0;
-            nb.for_each(i, |j, rij, r| {
-                if !p.is_fluid(j) {
-                    walls += op.interior_coefficient(i, j, rij, r) * op.ghost(i, j, rij);
-                }
-            });
-            divergence_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i) + walls
+    fill(b, |i| {
+        let walls = op.wall_source(i);
+        match op.roles[i] {
+            Role::Interior => {
+                divergence_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i) + walls
+            }
+            Role::Surface | Role::Splash | Role::Wall => walls,
         }
-        Role::Surface => {
-            let mut walls = 0.0;
-            nb.for_each(i, |j, rij, r| {
-                if !p.is_fluid(j) {
-                    walls += op.surface_coefficient(i, j, rij, r) * op.ghost(i, j, rij);
-                }
-            });
-            -walls
-        }
-        Role::Splash | Role::Wall => 0.0,
     });
 }
 
@@ -270,66 +261,95 @@ pub struct PressureOperator<'a, const D: usize> {
     pub roles: &'a [Role],
     /// The row vectors of `row_vectors`.
     pub row_vectors: &'a [Vec<f64>; D],
+    /// m_j of fluid particles, zero for walls: the unknowns the rows couple.
+    pub fluid_mass: &'a [f64],
     pub gravity: [f64; D],
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
-    #[inline]
-    fn row_vector_dot(&self, i: usize, rij: [f64; D]) -> f64 {
-        (0..D).map(|d| self.row_vectors[d][i] * rij[d]).sum()
-    }
-
-    /// P_b − P_i of wall neighbour b of fluid particle i.
-    #[inline]
-    fn ghost(&self, i: usize, b: usize, rib: [f64; D]) -> f64 {
-        ghost_pressure_difference(self.p, self.gravity, i, b, rib)
-    }
-
-    /// Coefficient of (P_i − P_j) in the interior row i: max(a_ij − V_j ĉ_i·∇W_ij, 0).
-    #[inline]
-    fn interior_coefficient(&self, i: usize, j: usize, rij: [f64; D], r: f64) -> f64 {
+    /// Weights of (P_i − P_j) in the interior row i for the lanes `l`, with `mass` the masses
+    /// of the lanes that count (zero for the others): max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij of
+    /// Eq. (27).
+    #[inline(always)]
+    fn interior_weights(&self, i: usize, l: &Lanes<D>, mass: f64x4) -> f64x4 {
         let (nb, p) = (self.nb, self.p);
-        let coefficient = laplacian_coefficient(nb, p, i, j, r)
-            - p.mass[j] / p.rest_density[j]
-                * nb.kernel.grad_factor(r)
-                * self.row_vector_dot(i, rij);
+        let f = nb.kernel.grad_factor4(l.r);
+        let laplacian = f64x4::splat(-2.0 / p.rest_density[i]) * mass * nb.laplacian_factor4(l.r);
+        let correction = mass / l.load(&p.rest_density) * f * self.row_vector_dot(i, l);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
-        coefficient.max(0.0)
+        (laplacian - correction).max(f64x4::ZERO) & l.mask
     }
 
-    /// Coefficient of (P_j − P_i) in the Robin row i: V_j q_i·∇W_ij.
-    #[inline]
-    fn surface_coefficient(&self, i: usize, j: usize, rij: [f64; D], r: f64) -> f64 {
+    /// Weights of (P_j − P_i) in the Robin row i: V_j q_i·∇W_ij (see `interior_weights`).
+    #[inline(always)]
+    fn surface_weights(&self, i: usize, l: &Lanes<D>, mass: f64x4) -> f64x4 {
         let (nb, p) = (self.nb, self.p);
-        p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r) * self.row_vector_dot(i, rij)
+        let f = nb.kernel.grad_factor4(l.r);
+        (mass / l.load(&p.rest_density) * f * self.row_vector_dot(i, l)) & l.mask
+    }
+
+    /// ĉ_i·r_ij (interior) or q_i·r_ij (surface) per lane.
+    #[inline(always)]
+    fn row_vector_dot(&self, i: usize, l: &Lanes<D>) -> f64x4 {
+        (0..D).fold(f64x4::ZERO, |s, d| {
+            f64x4::splat(self.row_vectors[d][i]).mul_add(l.rij[d], s)
+        })
+    }
+
+    /// P_b − P_i of the wall lanes (see `wall::ghost_pressure_difference`).
+    #[inline(always)]
+    fn ghosts(&self, i: usize, l: &Lanes<D>) -> f64x4 {
+        let p = self.p;
+        let g_r = (0..D).fold(f64x4::ZERO, |s, d| {
+            let across = l.load(&p.normal[d]).cmp_ne(f64x4::ZERO);
+            (f64x4::splat(self.gravity[d]) * l.rij[d] & across) + s
+        });
+        f64x4::splat(-p.rest_density[i]) * g_r
+    }
+
+    /// Masses of the wall lanes.
+    #[inline(always)]
+    fn wall_masses(&self, l: &Lanes<D>) -> f64x4 {
+        l.load(&self.p.mass) - l.load(self.fluid_mass)
+    }
+
+    /// The wall part of the right-hand side of row i: the Neumann ghosts' known differences.
+    fn wall_source(&self, i: usize) -> f64 {
+        let mut b = f64x4::ZERO;
+        match self.roles[i] {
+            Role::Interior => self.nb.for_each_lanes(i, |l| {
+                b += self.interior_weights(i, l, self.wall_masses(l)) * self.ghosts(i, l);
+            }),
+            Role::Surface => self.nb.for_each_lanes(i, |l| {
+                b -= self.surface_weights(i, l, self.wall_masses(l)) * self.ghosts(i, l);
+            }),
+            Role::Splash | Role::Wall => {}
+        }
+        b.reduce_add()
     }
 
     /// (A x)_i.
     #[inline]
     fn row(&self, x: &[f64], i: usize) -> f64 {
-        let (nb, p) = (self.nb, self.p);
+        let nb = self.nb;
+        let xi = f64x4::splat(x[i]);
+        let mut ax = f64x4::ZERO;
         match self.roles[i] {
-            Role::Interior => {
-                let mut ax = 0.0;
-                nb.for_each(i, |j, rij, r| {
-                    if p.is_fluid(j) {
-                        ax += self.interior_coefficient(i, j, rij, r) * (x[i] - x[j]);
-                    }
-                });
-                ax
-            }
-            Role::Surface => {
-                let mut ax = x[i];
-                nb.for_each(i, |j, rij, r| {
-                    if p.is_fluid(j) {
-                        ax += self.surface_coefficient(i, j, rij, r) * (x[j] - x[i]);
-                    }
-                });
-                ax
-            }
-            Role::Splash | Role::Wall => x[i],
+            Role::Interior => nb.for_each_lanes(i, |l| {
+                let w = self.interior_weights(i, l, l.load(self.fluid_mass));
+                ax = w.mul_add(xi - l.load(x), ax);
+            }),
+            Role::Surface => nb.for_each_lanes(i, |l| {
+                let w = self.surface_weights(i, l, l.load(self.fluid_mass));
+                ax = w.mul_add(l.load(x) - xi, ax);
+            }),
+            Role::Splash | Role::Wall => {}
+        }
+        match self.roles[i] {
+            Role::Interior => ax.reduce_add(),
+            Role::Surface | Role::Splash | Role::Wall => x[i] + ax.reduce_add(),
         }
     }
 }
@@ -344,32 +364,76 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
     }
 
     fn diagonal(&self, diag: &mut [f64]) {
-        let (nb, p) = (self.nb, self.p);
-        fill(diag, |i| match self.roles[i] {
-            Role::Interior => {
-                let mut d = 0.0;
-                nb.for_each(i, |j, rij, r| {
-                    if p.is_fluid(j) {
-                        d += self.interior_coefficient(i, j, rij, r);
+        let nb = self.nb;
+        fill(diag, |i| {
+            let mut d = f64x4::ZERO;
+            match self.roles[i] {
+                Role::Interior => {
+                    nb.for_each_lanes(i, |l| {
+                        d += self.interior_weights(i, l, l.load(self.fluid_mass))
+                    });
+                    // A row whose every weight was clipped holds its particle at P = 0.
+                    let d = d.reduce_add();
+                    if d > 0.0 {
+                        d
+                    } else {
+                        1.0
                     }
-                });
-                // A row whose every weight was clipped holds its particle at P = 0.
-                if d > 0.0 {
-                    d
-                } else {
-                    1.0
+                }
+                Role::Surface => {
+                    nb.for_each_lanes(i, |l| {
+                        d += self.surface_weights(i, l, l.load(self.fluid_mass))
+                    });
+                    1.0 - d.reduce_add()
+                }
+                Role::Splash | Role::Wall => 1.0,
+            }
+        })
+    }
+}
+
+impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
+    fn dims(&self) -> [usize; D] {
+        self.nb.grid().dims()
+    }
+
+    fn aggregate(&self, i: usize) -> Option<usize> {
+        match self.roles[i] {
+            Role::Interior | Role::Surface => Some(self.nb.grid().cell_of_sorted(i)),
+            Role::Splash | Role::Wall => None,
+        }
+    }
+
+    fn add_coarse_row(&self, i: usize, row: &mut [f64]) {
+        let grid = self.nb.grid();
+        let (dims, cell) = (grid.dims(), grid.cell_of_sorted(i));
+        let centre = stencil_slot([0; D]);
+        // Interior rows: a_ii = Σ w, a_ij = −w; Robin rows: a_ii = 1 − Σ w, a_ij = w.
+        let sign = match self.roles[i] {
+            Role::Interior => -1.0,
+            Role::Surface => {
+                row[centre] += 1.0;
+                1.0
+            }
+            Role::Splash | Role::Wall => return,
+        };
+        self.nb.for_each_lanes(i, |l| {
+            let w = match self.roles[i] {
+                Role::Interior => self.interior_weights(i, l, l.load(self.fluid_mass)),
+                _ => self.surface_weights(i, l, l.load(self.fluid_mass)),
+            }
+            .to_array();
+            for (k, w) in w.into_iter().enumerate() {
+                if w == 0.0 {
+                    continue;
+                }
+                row[centre] -= sign * w;
+                let j = l.j0 + k;
+                if self.aggregate(j).is_some() {
+                    let slot = stencil_slot(cell_offset(dims, cell, grid.cell_of_sorted(j)));
+                    row[slot] += sign * w;
                 }
             }
-            Role::Surface => {
-                let mut d = 1.0;
-                nb.for_each(i, |j, rij, r| {
-                    if p.is_fluid(j) {
-                        d -= self.surface_coefficient(i, j, rij, r);
-                    }
-                });
-                d
-            }
-            Role::Splash | Role::Wall => 1.0,
-        })
+        });
     }
 }

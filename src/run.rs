@@ -11,6 +11,7 @@ use crate::progress::Progress;
 use crate::resume::{self, ResumeError, ResumeOptions};
 use crate::scene::Scene;
 use crate::simulation::{NoFluid, NumericalFailure, Simulation, StepStats};
+use crate::timings::Timings;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -100,6 +101,8 @@ pub struct RunSummary {
     pub last: Option<StepStats>,
     /// The checkpoint of the final state.
     pub checkpoint: Saved,
+    /// Time spent in each stage of the step by this process.
+    pub timings: Timings,
 }
 
 pub fn run(scene: &Scene, opts: &RunOptions) -> Result<RunSummary, RunError> {
@@ -354,6 +357,7 @@ impl<'a, const D: usize> Driver<'a, D> {
             mean_ppe_iterations: ppe_total as f64 / steps.max(1) as f64,
             last,
             checkpoint,
+            timings: self.sim.timings.clone(),
         })
     }
 }

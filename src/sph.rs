@@ -1,58 +1,9 @@
-//! SPH discretisation: the one pair loop every operator is built on, and the operators of
-//! Eq. (20)–(27) written as per-particle sums over it.
+//! SPH discretisation: the operators of Eq. (20)–(27) written as per-particle sums over the
+//! pair loop of `neighbours`.
 
-use crate::grid::CellList;
-use crate::kernel::Quintic;
+pub use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
 use crate::wall::{behind_walls, ghost_velocity};
-
-/// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
-const ETA2_IN_H2: f64 = 1.0e-4;
-
-/// The neighbourhood of every particle: positions sorted by cell plus the kernel.
-pub struct Neighbours<'a, const D: usize> {
-    grid: &'a CellList<D>,
-    pos: &'a [Vec<f64>; D],
-    pub kernel: Quintic<D>,
-    support2: f64,
-    eta2: f64,
-}
-
-impl<'a, const D: usize> Neighbours<'a, D> {
-    pub fn new(grid: &'a CellList<D>, pos: &'a [Vec<f64>; D], kernel: Quintic<D>) -> Self {
-        let support2 = kernel.support() * kernel.support();
-        let eta2 = ETA2_IN_H2 * kernel.h() * kernel.h();
-        Self {
-            grid,
-            pos,
-            kernel,
-            support2,
-            eta2,
-        }
-    }
-
-    /// The pair loop: calls `f(j, r_ij, |r_ij|)` for every particle j ≠ i inside the kernel
-    /// support of i, walking the contiguous cell ranges around i.
-    #[inline]
-    pub fn for_each(&self, i: usize, mut f: impl FnMut(usize, [f64; D], f64)) {
-        let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
-        self.grid.for_each_neighbour_range(xi, |range| {
-            for j in range {
-                let rij: [f64; D] = std::array::from_fn(|d| xi[d] - self.pos[d][j]);
-                let r2: f64 = rij.iter().map(|x| x * x).sum();
-                if r2 < self.support2 && j != i {
-                    f(j, rij, r2.sqrt());
-                }
-            }
-        });
-    }
-
-    /// r_ij·∇W_ij / (r_ij² + η²), the radial factor shared by Eq. (26) and Eq. (27).
-    #[inline]
-    pub fn laplacian_factor(&self, r: f64) -> f64 {
-        r * r * self.kernel.grad_factor(r) / (r * r + self.eta2)
-    }
-}
 
 /// Summation density ρ_i = Σ_j m_j W_ij (self included).
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {

@@ -1,0 +1,141 @@
+//! The pair loop every operator is built on. The particles are sorted by cell (`grid`), so the
+//! neighbours of particle i lie in 3^(D−1) contiguous index ranges; the loop walks each range
+//! four particles at a time in SIMD lanes (`wide::f64x4`): positions are loaded contiguously,
+//! the distance test and the kernel are evaluated for four pairs at once, and each operator
+//! accumulates in lanes, summed at the end in a fixed order. Lanes past the end of a range hold
+//! particles of the next cells, at least one cell (one kernel support) away, so the distance
+//! test masks them; lanes past the end of the arrays read far-away sentinels.
+//!
+//! `for_each` offers the same walk one neighbour at a time, for the operators that run once per
+//! step; the hot loops (the PPE apply, density, …) work on the lanes directly.
+
+use crate::grid::CellList;
+use crate::kernel::Quintic;
+use wide::{f64x4, CmpLt};
+
+/// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
+const ETA2_IN_H2: f64 = 1.0e-4;
+/// Lanes per SIMD chunk.
+pub const LANES: usize = 4;
+/// Coordinate of the lanes past the end of the arrays: farther than any support.
+const SENTINEL: f64 = 1.0e30;
+
+/// Four consecutive candidate neighbours j0 … j0+3 of particle i.
+#[derive(Clone, Copy, Debug)]
+pub struct Lanes<const D: usize> {
+    /// Index of the first lane.
+    pub j0: usize,
+    /// r_ij = r_i − r_j per lane.
+    pub rij: [f64x4; D],
+    /// |r_ij| per lane (0 where masked).
+    pub r: f64x4,
+    /// All bits set in the lanes that are neighbours (inside the support, j ≠ i), zero elsewhere.
+    pub mask: f64x4,
+}
+
+impl<const D: usize> Lanes<D> {
+    /// `a[j0 .. j0 + 4]`, zero past the end of `a`.
+    #[inline(always)]
+    pub fn load(&self, a: &[f64]) -> f64x4 {
+        load(a, self.j0, 0.0)
+    }
+
+    /// Whether lane k is a neighbour.
+    #[inline(always)]
+    pub fn active(&self, k: usize) -> bool {
+        self.mask.to_array()[k] != 0.0
+    }
+}
+
+/// a[j0 .. j0 + 4] with `fill` past the end of `a`.
+#[inline(always)]
+fn load(a: &[f64], j0: usize, fill: f64) -> f64x4 {
+    match a.get(j0..j0 + LANES) {
+        Some(s) => f64x4::from(<[f64; LANES]>::try_from(s).expect("four lanes")),
+        None => f64x4::from(std::array::from_fn(|k| {
+            a.get(j0 + k).copied().unwrap_or(fill)
+        })),
+    }
+}
+
+/// The neighbourhood of every particle: positions sorted by cell plus the kernel.
+pub struct Neighbours<'a, const D: usize> {
+    grid: &'a CellList<D>,
+    pos: &'a [Vec<f64>; D],
+    pub kernel: Quintic<D>,
+    support2: f64,
+    eta2: f64,
+}
+
+impl<'a, const D: usize> Neighbours<'a, D> {
+    pub fn new(grid: &'a CellList<D>, pos: &'a [Vec<f64>; D], kernel: Quintic<D>) -> Self {
+        let support2 = kernel.support() * kernel.support();
+        let eta2 = ETA2_IN_H2 * kernel.h() * kernel.h();
+        Self {
+            grid,
+            pos,
+            kernel,
+            support2,
+            eta2,
+        }
+    }
+
+    /// The cell list the particles are sorted by.
+    pub fn grid(&self) -> &CellList<D> {
+        self.grid
+    }
+
+    /// The pair loop in lanes: calls `f` with every chunk of four candidates around particle
+    /// i that holds at least one neighbour.
+    #[inline(always)]
+    pub fn for_each_lanes(&self, i: usize, mut f: impl FnMut(&Lanes<D>)) {
+        let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
+        let support2 = f64x4::splat(self.support2);
+        self.grid.for_each_neighbour_range(xi, |range| {
+            for j0 in range.step_by(LANES) {
+                let rij: [f64x4; D] =
+                    std::array::from_fn(|d| f64x4::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL));
+                let r2 = rij.iter().fold(f64x4::ZERO, |s, x| x.mul_add(*x, s));
+                let mut mask = r2.cmp_lt(support2);
+                if (j0..j0 + LANES).contains(&i) {
+                    let mut bits = mask.to_array();
+                    bits[i - j0] = 0.0;
+                    mask = f64x4::from(bits);
+                }
+                if mask.none() {
+                    continue;
+                }
+                let r = (r2 & mask).sqrt();
+                f(&Lanes { j0, rij, r, mask });
+            }
+        });
+    }
+
+    /// The pair loop one neighbour at a time: calls `f(j, r_ij, |r_ij|)` for every particle
+    /// j ≠ i inside the kernel support of i.
+    #[inline(always)]
+    pub fn for_each(&self, i: usize, mut f: impl FnMut(usize, [f64; D], f64)) {
+        self.for_each_lanes(i, |l| {
+            let r = l.r.to_array();
+            let rij = l.rij.map(|x| x.to_array());
+            for k in 0..LANES {
+                if l.active(k) {
+                    f(l.j0 + k, std::array::from_fn(|d| rij[d][k]), r[k]);
+                }
+            }
+        });
+    }
+
+    /// r_ij·∇W_ij / (r_ij² + η²), the radial factor shared by Eq. (26) and Eq. (27).
+    #[inline]
+    pub fn laplacian_factor(&self, r: f64) -> f64 {
+        r * r * self.kernel.grad_factor(r) / (r * r + self.eta2)
+    }
+
+    /// `laplacian_factor` in lanes.
+    #[inline(always)]
+    pub fn laplacian_factor4(&self, r: f64x4) -> f64x4 {
+        let r2 = r * r;
+        r2 * self.kernel.grad_factor4(r) / (r2 + f64x4::splat(self.eta2))
+    }
+}

@@ -1,0 +1,446 @@
+//! One projection step, Eq. (5)–(8), as a sequence of stages over the particles sorted by
+//! cell: summation density → kernel corrections and free surface → predictor → pressure
+//! Poisson equation → corrector → shifting → advection. Each stage reads the particles and
+//! writes its own workspace arrays, which are allocated once and reused; the step then swaps
+//! the new velocity, pressure and density into the particles.
+
+use crate::free_surface::Support;
+use crate::grid::CellList;
+use crate::kernel::Quintic;
+use crate::linsolve::{BiCgStab, SolveInfo, SolverError, SolverParams};
+use crate::multigrid::Multigrid;
+use crate::particles::{components, Kind, Particles};
+use crate::ppe::{self, PressureOperator, Role};
+use crate::reduce::{self, fill, fill_vector};
+use crate::shifting::Shifting;
+use crate::sph::{self, Correction, Neighbours};
+use crate::timings::{Stage, Timings};
+use crate::turbulence;
+use crate::wall;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// The constants of a step that come from the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct StepSettings<const D: usize> {
+    pub gravity: [f64; D],
+    pub spacing: f64,
+    /// Relaxation α of the density-invariance term of Eq. (6).
+    pub alpha: f64,
+    pub solver: SolverParams,
+}
+
+/// What a step measured.
+#[derive(Clone, Copy, Debug)]
+pub struct StepReport {
+    pub solve: SolveInfo,
+    /// Mean |ρ/ρ0 − 1| over fluid particles with no free surface in reach.
+    pub density_error: f64,
+}
+
+/// Per-step arrays, allocated once and reused.
+pub struct Workspace<const D: usize> {
+    /// Summation density of the step (swapped into the particles).
+    density: Vec<f64>,
+    /// How the neighbours fill each kernel support (free surface, shifting).
+    supports: Vec<Support<D>>,
+    roles: Vec<Role>,
+    /// The role of each particle as written to the frames (`Particles::free_surface`).
+    free_surface: Vec<u8>,
+    /// No free-surface particle in the kernel support.
+    full_support: Vec<bool>,
+    /// Kernel gradient correction L_i of each particle, Eq. (25).
+    corrections: Vec<Correction<D>>,
+    /// The correction L'_i of the pressure gradient, whose wall ghosts carry the normal part
+    /// of the gradient only (see `sph::Moments`).
+    pressure_corrections: Vec<Correction<D>>,
+    /// Smagorinsky eddy viscosity ν_t.
+    eddy: Vec<f64>,
+    u_star: [Vec<f64>; D],
+    /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
+    row_vectors: [Vec<f64>; D],
+    /// m_j of fluid particles, zero for walls (the unknowns of the PPE).
+    fluid_mass: Vec<f64>,
+    rhs: Vec<f64>,
+    pressure: Vec<f64>,
+    bicgstab: BiCgStab,
+    multigrid: Multigrid<D>,
+    /// Normal of the wall each fluid particle touches (zero: none).
+    contact: [Vec<f64>; D],
+    velocity: [Vec<f64>; D],
+    /// Shifting displacement δr of each particle.
+    shift: [Vec<f64>; D],
+}
+
+impl<const D: usize> Default for Workspace<D> {
+    fn default() -> Self {
+        Self {
+            density: Vec::new(),
+            supports: Vec::new(),
+            roles: Vec::new(),
+            free_surface: Vec::new(),
+            full_support: Vec::new(),
+            corrections: Vec::new(),
+            pressure_corrections: Vec::new(),
+            eddy: Vec::new(),
+            u_star: components(),
+            row_vectors: components(),
+            fluid_mass: Vec::new(),
+            rhs: Vec::new(),
+            pressure: Vec::new(),
+            bicgstab: BiCgStab::default(),
+            multigrid: Multigrid::default(),
+            contact: components(),
+            velocity: components(),
+            shift: components(),
+        }
+    }
+}
+
+impl<const D: usize> Workspace<D> {
+    /// Advances the particles (sorted by cell in `grid`) by one step of `dt`.
+    pub fn project(
+        &mut self,
+        p: &mut Particles<D>,
+        grid: &CellList<D>,
+        kernel: Quintic<D>,
+        set: &StepSettings<D>,
+        dt: f64,
+        timings: &mut Timings,
+    ) -> Result<StepReport, SolverError> {
+        self.resize(p.len());
+        let report = {
+            let nb = Neighbours::new(grid, &p.pos, kernel);
+            let mut clock = Instant::now();
+            let mut lap = |stage: Stage| {
+                let now = Instant::now();
+                timings.add(stage, now - clock);
+                clock = now;
+            };
+            self.summation_density(&nb, p);
+            std::mem::swap(&mut p.density, &mut self.density);
+            lap(Stage::Density);
+            self.classify(&nb, p, set.gravity);
+            std::mem::swap(&mut p.free_surface, &mut self.free_surface);
+            lap(Stage::FreeSurface);
+            self.predict(&nb, p, set, dt);
+            lap(Stage::Predictor);
+            let solve = self.solve_pressure(&nb, p, set, dt)?;
+            fill(&mut p.pressure, |i| self.pressure[i].max(0.0));
+            lap(Stage::PressureSolve);
+            self.correct(&nb, p, set, dt);
+            std::mem::swap(&mut p.vel, &mut self.velocity);
+            let density_error = self.density_error(p);
+            lap(Stage::Corrector);
+            self.shift(&nb, p, set, dt);
+            std::mem::swap(&mut p.vel, &mut self.velocity);
+            std::mem::swap(&mut p.pressure, &mut self.pressure);
+            lap(Stage::Shifting);
+            StepReport {
+                solve,
+                density_error,
+            }
+        };
+        let clock = Instant::now();
+        self.advect(p, dt);
+        timings.add(Stage::Advection, clock.elapsed());
+        Ok(report)
+    }
+
+    fn resize(&mut self, n: usize) {
+        for a in [
+            &mut self.density,
+            &mut self.eddy,
+            &mut self.fluid_mass,
+            &mut self.rhs,
+        ] {
+            a.resize(n, 0.0);
+        }
+        self.pressure.resize(n, 0.0);
+        for a in self
+            .u_star
+            .iter_mut()
+            .chain(&mut self.row_vectors)
+            .chain(&mut self.contact)
+            .chain(&mut self.velocity)
+            .chain(&mut self.shift)
+        {
+            a.resize(n, 0.0);
+        }
+        self.supports.resize(n, Support::FULL);
+        self.roles.resize(n, Role::Wall);
+        self.free_surface.resize(n, 0);
+        self.full_support.resize(n, false);
+        self.corrections.resize(n, None);
+        self.pressure_corrections.resize(n, None);
+    }
+
+    /// Summation density; walls keep their rest density.
+    fn summation_density(&mut self, nb: &Neighbours<D>, p: &Particles<D>) {
+        fill(&mut self.density, |i| match p.kind[i] {
+            Kind::Fluid => sph::density(nb, p, i),
+            Kind::Wall => p.rest_density[i],
+        });
+    }
+
+    /// Kernel gradient corrections, Eq. (25), once per step for every operator below; how each
+    /// support is filled; the free surface and the role of each particle in the PPE.
+    fn classify(&mut self, nb: &Neighbours<D>, p: &Particles<D>, gravity: [f64; D]) {
+        self.corrections
+            .par_iter_mut()
+            .zip(&mut self.pressure_corrections)
+            .zip(&mut self.supports)
+            .enumerate()
+            .for_each(|(i, ((l, lp), support))| {
+                (*l, *lp, *support) = match p.kind[i] {
+                    Kind::Fluid => {
+                        let mo = sph::support_moments(nb, p, i);
+                        (
+                            sph::gradient_correction(mo.m),
+                            sph::gradient_correction(mo.m_neumann),
+                            Support::new(&mo.m, mo.grad_c),
+                        )
+                    }
+                    Kind::Wall => (None, None, Support::FULL),
+                }
+            });
+        ppe::assign_roles(
+            nb,
+            p,
+            &self.supports,
+            &self.pressure_corrections,
+            gravity,
+            &mut self.roles,
+        );
+        ppe::full_support(nb, &self.roles, &mut self.full_support);
+        fill(&mut self.free_surface, |i| match self.roles[i] {
+            Role::Surface => 1,
+            Role::Splash => 2,
+            Role::Interior | Role::Wall => 0,
+        });
+        // Inside the fluid (no free surface in reach) the moment matrix measures the disorder of
+        // the particles, not a truncated support: corrected there, the divergence of the PPE
+        // source amplifies that disorder into the pressure (measured: a collision of two blocks
+        // gains energy instead of losing it). The pressure gradient keeps its correction, which
+        // there corrects the wall ghosts' missing tangential gradient.
+        self.corrections
+            .par_iter_mut()
+            .zip(&self.full_support)
+            .for_each(|(l, &full)| {
+                if full {
+                    *l = None;
+                }
+            });
+    }
+
+    /// Predictor, Eq. (5): u* = uⁿ + Δt (∇·((ν + ν_t)∇uⁿ) + τ_w + g), with ν_t the Smagorinsky
+    /// eddy viscosity (Eq. 3–4) and τ_w the turbulent wall shear; walls stay at rest.
+    fn predict(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
+        let (corrections, spacing, gravity) = (&self.corrections, set.spacing, set.gravity);
+        fill(&mut self.eddy, |i| match p.kind[i] {
+            Kind::Fluid => turbulence::eddy_viscosity(nb, p, &corrections[i], spacing, i),
+            Kind::Wall => 0.0,
+        });
+        let eddy = &self.eddy;
+        fill_vector(&mut self.u_star, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let visc = sph::viscous_acceleration(nb, p, eddy, i);
+                let wall = turbulence::wall_shear(nb, p, spacing, i);
+                std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + wall[d] + gravity[d]))
+            }
+            Kind::Wall => [0.0; D],
+        });
+    }
+
+    /// PPE, Eq. (6), solved by BiCGSTAB from the last pressure (warm start; walls hold no
+    /// unknown). The solution is left in `self.pressure`.
+    fn solve_pressure(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        dt: f64,
+    ) -> Result<SolveInfo, SolverError> {
+        ppe::row_vectors(
+            nb,
+            p,
+            &self.roles,
+            &self.pressure_corrections,
+            &self.supports,
+            set.spacing,
+            &mut self.row_vectors,
+        );
+        fill(&mut self.fluid_mass, |i| {
+            if p.is_fluid(i) {
+                p.mass[i]
+            } else {
+                0.0
+            }
+        });
+        let op = PressureOperator {
+            nb,
+            p,
+            roles: &self.roles,
+            row_vectors: &self.row_vectors,
+            fluid_mass: &self.fluid_mass,
+            gravity: set.gravity,
+        };
+        ppe::source(
+            &op,
+            &self.full_support,
+            &self.corrections,
+            &self.u_star,
+            dt,
+            set.alpha,
+            &mut self.rhs,
+        );
+        let roles = &self.roles;
+        fill(&mut self.pressure, |i| match roles[i] {
+            Role::Interior | Role::Surface => p.pressure[i],
+            Role::Splash | Role::Wall => 0.0,
+        });
+        self.bicgstab.solve(
+            &op,
+            &mut self.multigrid,
+            &self.rhs,
+            &mut self.pressure,
+            set.solver,
+        )
+    }
+
+    /// Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls
+    /// as ghosts; particles touching a wall keep no velocity into it (`wall::no_penetration`).
+    fn correct(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
+        fill_vector(&mut self.contact, |i| match p.kind[i] {
+            Kind::Fluid => wall::contact_normal(nb, p, set.spacing, i),
+            Kind::Wall => [0.0; D],
+        });
+        let (u_star, contact) = (&self.u_star, &self.contact);
+        let corrections = &self.pressure_corrections;
+        fill_vector(&mut self.velocity, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let grad = pressure_gradient(nb, p, set.gravity, &corrections[i], i);
+                let rho0 = p.rest_density[i];
+                let u = std::array::from_fn(|d| u_star[d][i] - dt * grad[d] / rho0);
+                wall::no_penetration(u, vector(contact, i))
+            }
+            Kind::Wall => [0.0; D],
+        });
+    }
+
+    /// Mean |ρ/ρ0 − 1| where the summation density is not truncated by the free surface.
+    fn density_error(&self, p: &Particles<D>) -> f64 {
+        let full = &self.full_support;
+        let n_full = full.iter().filter(|&&f| f).count();
+        if n_full == 0 {
+            return 0.0;
+        }
+        let sum = reduce::sum(p.len(), |i| {
+            if full[i] {
+                (p.density[i] / p.rest_density[i] - 1.0).abs()
+            } else {
+                0.0
+            }
+        });
+        sum / n_full as f64
+    }
+
+    /// Particle shifting δr = −D ∇C (Eq. 10) at rⁿ, then velocity and pressure carried to the
+    /// shifted position by Eq. (9); the new velocity and pressure are left in `self.velocity`
+    /// and `self.pressure` (walls: the pressure their fluid neighbours give them).
+    fn shift(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
+        let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
+        let shifting = Shifting::new(nb, set.spacing, max_speed, dt);
+        let (roles, supports, full, contact) = (
+            &self.roles,
+            &self.supports,
+            &self.full_support,
+            &self.contact,
+        );
+        fill_vector(&mut self.shift, |i| match roles[i] {
+            // Splashes are left in place: neither ∇C nor the Taylor correction means anything
+            // there.
+            Role::Interior | Role::Surface => {
+                let dr = shifting.displacement(nb, p, &supports[i], full[i], i);
+                wall::no_penetration(dr, vector(contact, i))
+            }
+            Role::Splash | Role::Wall => [0.0; D],
+        });
+        let (shift, corrections) = (&self.shift, &self.corrections);
+        fill_vector(&mut self.velocity, |i| match p.kind[i] {
+            Kind::Fluid => {
+                // Where the free surface is in reach the velocity gradient is no longer that of
+                // a filled support, and shifting moves particles into the thinning, faster parts
+                // of a stretching flow: the Taylor step there feeds the flow energy (measured).
+                if !full[i] {
+                    return p.velocity(i);
+                }
+                let g = sph::velocity_gradient(
+                    nb,
+                    p,
+                    &corrections[i],
+                    |j| sph::fluid_velocity(p, i, j),
+                    i,
+                );
+                let dr = vector(shift, i);
+                std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
+            }
+            Kind::Wall => [0.0; D],
+        });
+        let pressure_corrections = &self.pressure_corrections;
+        fill(&mut self.pressure, |i| match p.kind[i] {
+            Kind::Fluid => {
+                let g = pressure_gradient(nb, p, set.gravity, &pressure_corrections[i], i);
+                let dr = vector(shift, i);
+                (p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>()).max(0.0)
+            }
+            Kind::Wall => wall::wall_pressure(nb, p, set.gravity, i),
+        });
+    }
+
+    /// Advection, Eq. (8), plus the shift.
+    fn advect(&self, p: &mut Particles<D>, dt: f64) {
+        for d in 0..D {
+            let (kind, vel, shift) = (&p.kind, &p.vel[d], &self.shift[d]);
+            p.pos[d]
+                .par_iter_mut()
+                .zip(vel)
+                .zip(kind)
+                .zip(shift)
+                .for_each(|(((x, v), k), s)| {
+                    if *k == Kind::Fluid {
+                        *x += dt * v + s;
+                    }
+                });
+        }
+    }
+}
+
+/// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25) and the walls as
+/// ghosts of its pressure (see `wall`).
+fn pressure_gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    gravity: [f64; D],
+    l: &Correction<D>,
+    i: usize,
+) -> [f64; D] {
+    sph::gradient(nb, p, l, i, |j, rij| match p.kind[j] {
+        Kind::Fluid => p.pressure[j] - p.pressure[i],
+        Kind::Wall => wall::ghost_pressure_difference(p, gravity, i, j, rij),
+    })
+}
+
+/// Component vector i of a SoA vector field.
+#[inline]
+fn vector<const D: usize>(a: &[Vec<f64>; D], i: usize) -> [f64; D] {
+    std::array::from_fn(|d| a[d][i])
+}
+
+/// |u_i|.
+pub fn speed<const D: usize>(p: &Particles<D>, i: usize) -> f64 {
+    (0..D)
+        .map(|d| p.vel[d][i] * p.vel[d][i])
+        .sum::<f64>()
+        .sqrt()
+}
