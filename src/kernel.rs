@@ -1,7 +1,7 @@
 //! The quintic spline kernel of Eq. (19) (Schoenberg / Morris 1997), support radius 3h.
 
 use std::f64::consts::PI;
-use wide::{f64x4, CmpGt};
+use wide::{f64x4, CmpEq};
 
 /// Support radius in units of the smoothing length h.
 pub const SUPPORT_IN_H: f64 = 3.0;
@@ -77,14 +77,22 @@ impl<const D: usize> Quintic<D> {
     /// F(r) = W'(r)/r in lanes (lanes with r = 0 take the limit W''(0)).
     #[inline(always)]
     pub fn grad_factor4(&self, r: f64x4) -> f64x4 {
+        let (dw_dr, at_zero) = self.derivative4(r);
+        let f = dw_dr / r.max(f64x4::splat(f64::MIN_POSITIVE));
+        at_zero.blend(f64x4::splat(self.grad_factor(0.0)), f)
+    }
+
+    /// W'(r) in lanes, and the mask of the lanes with r = 0.
+    #[inline(always)]
+    pub fn derivative4(&self, r: f64x4) -> (f64x4, f64x4) {
         let [a, b, c] = self.spline_terms4(r);
         let p4 = |x: f64x4| (x * x) * (x * x);
         let dw_dq = f64x4::splat(-5.0)
             * f64x4::splat(15.0).mul_add(p4(c), f64x4::splat(-6.0).mul_add(p4(b), p4(a)));
-        let at_zero = f64x4::splat(self.grad_factor(0.0));
-        let safe_r = r.max(f64x4::splat(f64::MIN_POSITIVE));
-        let f = f64x4::splat(self.norm * self.inv_h) * dw_dq / safe_r;
-        r.cmp_gt(f64x4::ZERO).blend(f, at_zero)
+        (
+            f64x4::splat(self.norm * self.inv_h) * dw_dq,
+            r.cmp_eq(f64x4::ZERO),
+        )
     }
 
     /// (3 − q)₊, (2 − q)₊, (1 − q)₊ with q = r/h.

@@ -98,19 +98,24 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 /// The per-row vector of the operator, with L'_i the correction of the pressure gradient
 /// (`sph::Moments::m_neumann`): ĉ_i = L'_iᵀ c_i of the consistent Laplacian for interior rows
 /// (see `laplacian_correction`), q_i = δ L'_iᵀ n_i of the Robin condition for surface rows
-/// (δ n·∇P_i = δ n·L'_i Σ_j … = q_i·Σ_j …), zero otherwise.
+/// (δ n·∇P_i = δ n·L'_i Σ_j … = q_i·Σ_j …), zero otherwise. Inside the fluid, away from walls
+/// and the free surface (`full` and no wall in reach), c_i measures only the disorder of the
+/// particles and the row is left uncorrected, as the divergence is. `corrected` marks the rows
+/// whose vector is not zero.
 #[allow(clippy::too_many_arguments)]
 pub fn row_vectors<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     roles: &[Role],
+    full: &[bool],
     pressure_corrections: &[Correction<D>],
     supports: &[Support<D>],
     spacing: f64,
     out: &mut [Vec<f64>; D],
+    corrected: &mut Vec<bool>,
 ) {
     fill_vector(out, |i| match roles[i] {
-        Role::Interior => laplacian_correction(nb, p, &pressure_corrections[i], i),
+        Role::Interior => laplacian_correction(nb, p, &pressure_corrections[i], full[i], i),
         Role::Surface => {
             let n = contact_line_normal(nb, p, supports[i].normal, spacing, i);
             let delta = 0.5 * spacing;
@@ -123,6 +128,8 @@ pub fn row_vectors<const D: usize>(
         }
         Role::Splash | Role::Wall => [0.0; D],
     });
+    corrected.resize(p.len(), false);
+    fill(corrected, |i| (0..D).any(|d| out[d][i] != 0.0));
 }
 
 /// The free-surface normal for the Robin row of surface particle i. Where the surface meets a
@@ -235,19 +242,26 @@ fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Correction<D>,
+    full: bool,
     i: usize,
 ) -> [f64; D] {
-    let mut c = [0.0; D];
+    let (mut c, mut near_wall) = ([0.0; D], false);
     nb.for_each(i, |j, rij, r| {
         let cl = 2.0 * p.mass[j] / p.rest_density[i] * nb.laplacian_factor(r);
         let followed = match p.kind[j] {
             Kind::Fluid => rij,
-            Kind::Wall => behind_walls(p, j, rij),
+            Kind::Wall => {
+                near_wall = true;
+                behind_walls(p, j, rij)
+            }
         };
         for d in 0..D {
             c[d] += cl * followed[d];
         }
     });
+    if full && !near_wall {
+        return [0.0; D];
+    }
     match l {
         Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[b][a] * c[b]).sum()),
         None => c,
@@ -261,21 +275,27 @@ pub struct PressureOperator<'a, const D: usize> {
     pub roles: &'a [Role],
     /// The row vectors of `row_vectors`.
     pub row_vectors: &'a [Vec<f64>; D],
-    /// m_j of fluid particles, zero for walls: the unknowns the rows couple.
-    pub fluid_mass: &'a [f64],
+    /// V_j = m_j/ρ0_j of fluid particles, zero for walls: the unknowns the rows couple.
+    pub fluid_volume: &'a [f64],
+    /// Whether row i carries the consistency correction (its row vector is not zero).
+    pub corrected: &'a [bool],
     pub gravity: [f64; D],
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
-    /// Weights of (P_i − P_j) in the interior row i for the lanes `l`, with `mass` the masses
-    /// of the lanes that count (zero for the others): max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij of
-    /// Eq. (27).
+    /// Weights of (P_i − P_j) in the interior row i for the lanes `l`, with `volume` the
+    /// volumes V_j of the lanes that count (zero for the others): max(a_ij − V_j ĉ_i·∇W_ij, 0),
+    /// a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
     #[inline(always)]
-    fn interior_weights(&self, i: usize, l: &Lanes<D>, mass: f64x4) -> f64x4 {
+    fn interior_weights(&self, i: usize, l: &Lanes<D>, volume: f64x4) -> f64x4 {
         let (nb, p) = (self.nb, self.p);
-        let f = nb.kernel.grad_factor4(l.r);
-        let laplacian = f64x4::splat(-2.0 / p.rest_density[i]) * mass * nb.laplacian_factor4(l.r);
-        let correction = mass / l.load(&p.rest_density) * f * self.row_vector_dot(i, l);
+        let (f, laplacian_factor) = nb.gradient_and_laplacian_factors4(l.r);
+        let mass = volume * l.load(&p.rest_density);
+        let laplacian = f64x4::splat(-2.0 / p.rest_density[i]) * mass * laplacian_factor;
+        if !self.corrected[i] {
+            return laplacian & l.mask;
+        }
+        let correction = volume * f * self.row_vector_dot(i, l);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
@@ -284,10 +304,9 @@ impl<const D: usize> PressureOperator<'_, D> {
 
     /// Weights of (P_j − P_i) in the Robin row i: V_j q_i·∇W_ij (see `interior_weights`).
     #[inline(always)]
-    fn surface_weights(&self, i: usize, l: &Lanes<D>, mass: f64x4) -> f64x4 {
-        let (nb, p) = (self.nb, self.p);
-        let f = nb.kernel.grad_factor4(l.r);
-        (mass / l.load(&p.rest_density) * f * self.row_vector_dot(i, l)) & l.mask
+    fn surface_weights(&self, i: usize, l: &Lanes<D>, volume: f64x4) -> f64x4 {
+        let f = self.nb.kernel.grad_factor4(l.r);
+        (volume * f * self.row_vector_dot(i, l)) & l.mask
     }
 
     /// ĉ_i·r_ij (interior) or q_i·r_ij (surface) per lane.
@@ -309,10 +328,10 @@ impl<const D: usize> PressureOperator<'_, D> {
         f64x4::splat(-p.rest_density[i]) * g_r
     }
 
-    /// Masses of the wall lanes.
+    /// Volumes of the wall lanes.
     #[inline(always)]
-    fn wall_masses(&self, l: &Lanes<D>) -> f64x4 {
-        l.load(&self.p.mass) - l.load(self.fluid_mass)
+    fn wall_volumes(&self, l: &Lanes<D>) -> f64x4 {
+        l.load(&self.p.mass) / l.load(&self.p.rest_density) - l.load(self.fluid_volume)
     }
 
     /// The wall part of the right-hand side of row i: the Neumann ghosts' known differences.
@@ -320,10 +339,10 @@ impl<const D: usize> PressureOperator<'_, D> {
         let mut b = f64x4::ZERO;
         match self.roles[i] {
             Role::Interior => self.nb.for_each_lanes(i, |l| {
-                b += self.interior_weights(i, l, self.wall_masses(l)) * self.ghosts(i, l);
+                b += self.interior_weights(i, l, self.wall_volumes(l)) * self.ghosts(i, l);
             }),
             Role::Surface => self.nb.for_each_lanes(i, |l| {
-                b -= self.surface_weights(i, l, self.wall_masses(l)) * self.ghosts(i, l);
+                b -= self.surface_weights(i, l, self.wall_volumes(l)) * self.ghosts(i, l);
             }),
             Role::Splash | Role::Wall => {}
         }
@@ -338,11 +357,11 @@ impl<const D: usize> PressureOperator<'_, D> {
         let mut ax = f64x4::ZERO;
         match self.roles[i] {
             Role::Interior => nb.for_each_lanes(i, |l| {
-                let w = self.interior_weights(i, l, l.load(self.fluid_mass));
+                let w = self.interior_weights(i, l, l.load(self.fluid_volume));
                 ax = w.mul_add(xi - l.load(x), ax);
             }),
             Role::Surface => nb.for_each_lanes(i, |l| {
-                let w = self.surface_weights(i, l, l.load(self.fluid_mass));
+                let w = self.surface_weights(i, l, l.load(self.fluid_volume));
                 ax = w.mul_add(l.load(x) - xi, ax);
             }),
             Role::Splash | Role::Wall => {}
@@ -370,7 +389,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
             match self.roles[i] {
                 Role::Interior => {
                     nb.for_each_lanes(i, |l| {
-                        d += self.interior_weights(i, l, l.load(self.fluid_mass))
+                        d += self.interior_weights(i, l, l.load(self.fluid_volume))
                     });
                     // A row whose every weight was clipped holds its particle at P = 0.
                     let d = d.reduce_add();
@@ -382,7 +401,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
                 }
                 Role::Surface => {
                     nb.for_each_lanes(i, |l| {
-                        d += self.surface_weights(i, l, l.load(self.fluid_mass))
+                        d += self.surface_weights(i, l, l.load(self.fluid_volume))
                     });
                     1.0 - d.reduce_add()
                 }
@@ -419,8 +438,8 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
         };
         self.nb.for_each_lanes(i, |l| {
             let w = match self.roles[i] {
-                Role::Interior => self.interior_weights(i, l, l.load(self.fluid_mass)),
-                _ => self.surface_weights(i, l, l.load(self.fluid_mass)),
+                Role::Interior => self.interior_weights(i, l, l.load(self.fluid_volume)),
+                _ => self.surface_weights(i, l, l.load(self.fluid_volume)),
             }
             .to_array();
             for (k, w) in w.into_iter().enumerate() {

@@ -59,8 +59,10 @@ pub struct Workspace<const D: usize> {
     u_star: [Vec<f64>; D],
     /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
     row_vectors: [Vec<f64>; D],
-    /// m_j of fluid particles, zero for walls (the unknowns of the PPE).
-    fluid_mass: Vec<f64>,
+    /// Rows with a non-zero row vector.
+    corrected: Vec<bool>,
+    /// V_j = m_j/ρ0_j of fluid particles, zero for walls (the unknowns of the PPE).
+    fluid_volume: Vec<f64>,
     rhs: Vec<f64>,
     pressure: Vec<f64>,
     bicgstab: BiCgStab,
@@ -85,7 +87,8 @@ impl<const D: usize> Default for Workspace<D> {
             eddy: Vec::new(),
             u_star: components(),
             row_vectors: components(),
-            fluid_mass: Vec::new(),
+            corrected: Vec::new(),
+            fluid_volume: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
             bicgstab: BiCgStab::default(),
@@ -151,7 +154,7 @@ impl<const D: usize> Workspace<D> {
         for a in [
             &mut self.density,
             &mut self.eddy,
-            &mut self.fluid_mass,
+            &mut self.fluid_volume,
             &mut self.rhs,
         ] {
             a.resize(n, 0.0);
@@ -265,14 +268,16 @@ impl<const D: usize> Workspace<D> {
             nb,
             p,
             &self.roles,
+            &self.full_support,
             &self.pressure_corrections,
             &self.supports,
             set.spacing,
             &mut self.row_vectors,
+            &mut self.corrected,
         );
-        fill(&mut self.fluid_mass, |i| {
+        fill(&mut self.fluid_volume, |i| {
             if p.is_fluid(i) {
-                p.mass[i]
+                p.mass[i] / p.rest_density[i]
             } else {
                 0.0
             }
@@ -282,7 +287,8 @@ impl<const D: usize> Workspace<D> {
             p,
             roles: &self.roles,
             row_vectors: &self.row_vectors,
-            fluid_mass: &self.fluid_mass,
+            fluid_volume: &self.fluid_volume,
+            corrected: &self.corrected,
             gravity: set.gravity,
         };
         ppe::source(

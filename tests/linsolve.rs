@@ -80,7 +80,9 @@ fn bicgstab_matches_a_dense_solve_of_a_nonsymmetric_system() {
         tolerance: 1e-10,
         max_iterations: 2000,
     };
-    let info = BiCgStab::default().solve(&a, &mut Jacobi::default(), &b, &mut x, params).unwrap();
+    let info = BiCgStab::default()
+        .solve(&a, &mut Jacobi::default(), &b, &mut x, params)
+        .unwrap();
     assert!(info.converged && info.relative_residual <= 1e-9, "{info:?}");
     let err = x
         .iter()
@@ -92,6 +94,8 @@ fn bicgstab_matches_a_dense_solve_of_a_nonsymmetric_system() {
     assert!(err / norm < 1e-7, "relative error {}", err / norm);
 
     // A warm start from the solution needs (almost) no iteration.
-    let info = BiCgStab::default().solve(&a, &mut Jacobi::default(), &b, &mut x, params).unwrap();
+    let info = BiCgStab::default()
+        .solve(&a, &mut Jacobi::default(), &b, &mut x, params)
+        .unwrap();
     assert!(info.iterations <= 1, "{info:?}");
 }
