@@ -95,21 +95,23 @@ impl<'a, const D: usize> Neighbours<'a, D> {
         let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
         let support2 = f64x4::splat(self.support2);
         self.grid.for_each_neighbour_range(xi, |range| {
-            for j0 in range.step_by(LANES) {
+            let mut j0 = range.start;
+            while j0 < range.end {
                 let rij: [f64x4; D] =
                     std::array::from_fn(|d| f64x4::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL));
                 let r2 = rij.iter().fold(f64x4::ZERO, |s, x| x.mul_add(*x, s));
                 let mut mask = r2.cmp_lt(support2);
-                if (j0..j0 + LANES).contains(&i) {
+                let own = i.wrapping_sub(j0);
+                if own < LANES {
                     let mut bits = mask.to_array();
-                    bits[i - j0] = 0.0;
+                    bits[own] = 0.0;
                     mask = f64x4::from(bits);
                 }
-                if mask.none() {
-                    continue;
+                if mask.any() {
+                    let r = (r2 & mask).sqrt();
+                    f(&Lanes { j0, rij, r, mask });
                 }
-                let r = (r2 & mask).sqrt();
-                f(&Lanes { j0, rij, r, mask });
+                j0 += LANES;
             }
         });
     }
