@@ -116,6 +116,7 @@ impl<const D: usize> Simulation<D> {
                     tolerance: scene.solver.tolerance,
                     max_iterations: scene.solver.max_iterations,
                 },
+                effects: scene.effects,
             },
             container: scene.container.clone(),
             obstacles: scene.obstacles.clone(),
@@ -216,6 +217,7 @@ impl<const D: usize> Simulation<D> {
     }
 
     fn finish_step(&mut self, dt: f64, report: StepReport) -> Result<StepStats, NumericalFailure> {
+        let clock = Instant::now();
         self.step += 1;
         let p = &self.particles;
         let fluid = |i: usize| p.is_fluid(i);
@@ -233,7 +235,7 @@ impl<const D: usize> Simulation<D> {
                 0.0
             }
         });
-        Ok(StepStats {
+        let stats = StepStats {
             step: self.step,
             time: self.time,
             dt,
@@ -243,7 +245,9 @@ impl<const D: usize> Simulation<D> {
             kinetic_energy,
             density_error: report.density_error,
             penetrations: self.penetrations(),
-        })
+        };
+        self.timings.add(Stage::Diagnostics, clock.elapsed());
+        Ok(stats)
     }
 
     /// Fluid particles whose centre lies inside a wall: outside the container or in an obstacle.
