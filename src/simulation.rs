@@ -5,6 +5,7 @@ use crate::grid::CellList;
 use crate::kernel::{Quintic, SUPPORT_IN_H};
 use crate::lattice;
 use crate::linsolve::{SolverError, SolverParams};
+use crate::memory::ArraySize;
 use crate::particles::Particles;
 use crate::reduce;
 use crate::scene::{Aabb, Scene};
@@ -248,6 +249,21 @@ impl<const D: usize> Simulation<D> {
         };
         self.timings.add(Stage::Diagnostics, clock.elapsed());
         Ok(stats)
+    }
+
+    /// Every per-particle array of the step with the stage that allocates it, as it is now:
+    /// the cell sort's and the workspace's (`Workspace::arrays`). The particles' own arrays are
+    /// `Particles::arrays_mut`.
+    pub fn arrays(&self) -> Vec<(Stage, ArraySize)> {
+        let sort = [
+            ArraySize::of("cell of particle", &self.cell_of),
+            ArraySize::of("sort order", &self.order),
+            ArraySize::of("sort scratch", &self.scratch),
+            self.grid.sorted_cells(),
+        ];
+        let mut arrays: Vec<_> = sort.into_iter().map(|a| (Stage::CellList, a)).collect();
+        arrays.extend(self.work.arrays());
+        arrays
     }
 
     /// Fluid particles whose centre lies inside a wall: outside the container or in an obstacle.

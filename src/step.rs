@@ -3,13 +3,15 @@
 //! pressure Poisson equation → corrector → wall pressure → shifting → advection (`stages`).
 //! The stages of the effects a scene turns off (`scene::Effects`) are skipped. Each stage reads
 //! the particles and writes its own workspace arrays, which it allocates when it first runs and
-//! reuses after, so the arrays of a stage that does not run are never allocated. The step swaps the new velocity, pressure and
+//! reuses after, so the arrays of a stage that does not run are never allocated
+//! (`Workspace::arrays` lists them all by stage). The step swaps the new velocity, pressure and
 //! density into the particles.
 
 use crate::free_surface::Support;
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::linsolve::{BiCgStab, SolveInfo, SolverError, SolverParams};
+use crate::memory::ArraySize;
 use crate::multigrid::Multigrid;
 use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
@@ -193,6 +195,83 @@ impl<const D: usize> Workspace<D> {
         self.advect(p, dt, effects.shifting.is_some());
         timings.add(Stage::Advection, clock.elapsed());
         Ok(report)
+    }
+
+    /// Every per-particle array of the workspace with the stage that allocates it, as it is
+    /// now (the exhaustive destructuring makes leaving out a new field a compile error).
+    pub fn arrays(&self) -> Vec<(Stage, ArraySize)> {
+        let Workspace {
+            density,
+            supports,
+            roles,
+            free_surface,
+            full_support,
+            gradient_defined,
+            corrections,
+            pressure_corrections,
+            eddy,
+            u_star,
+            row_vectors,
+            corrected,
+            fluid_volume,
+            rhs,
+            pressure,
+            bicgstab,
+            multigrid,
+            contact,
+            velocity,
+            shift,
+        } = self;
+        let mut arrays = vec![
+            (Stage::Density, ArraySize::of("density", density)),
+            (Stage::FreeSurface, ArraySize::of("support", supports)),
+            (Stage::FreeSurface, ArraySize::of("PPE role", roles)),
+            (
+                Stage::FreeSurface,
+                ArraySize::of("free surface", free_surface),
+            ),
+            (
+                Stage::FreeSurface,
+                ArraySize::of("full support", full_support),
+            ),
+            (
+                Stage::FreeSurface,
+                ArraySize::of("gradient defined", gradient_defined),
+            ),
+            (Stage::KernelCorrection, ArraySize::of("L", corrections)),
+            (
+                Stage::KernelCorrection,
+                ArraySize::of("L'", pressure_corrections),
+            ),
+            (Stage::EddyViscosity, ArraySize::of("ν_t", eddy)),
+            (Stage::Predictor, ArraySize::of_components("u*", u_star)),
+            (
+                Stage::PressureSolve,
+                ArraySize::of_components("row vector", row_vectors),
+            ),
+            (
+                Stage::PressureSolve,
+                ArraySize::of("corrected row", corrected),
+            ),
+            (
+                Stage::PressureSolve,
+                ArraySize::of("fluid volume", fluid_volume),
+            ),
+            (Stage::PressureSolve, ArraySize::of("right-hand side", rhs)),
+            (Stage::PressureSolve, ArraySize::of("pressure", pressure)),
+            (
+                Stage::Corrector,
+                ArraySize::of_components("contact normal", contact),
+            ),
+            (
+                Stage::Corrector,
+                ArraySize::of_components("velocity", velocity),
+            ),
+            (Stage::Shifting, ArraySize::of_components("δr", shift)),
+        ];
+        let solver = bicgstab.arrays().into_iter().chain(multigrid.fine_arrays());
+        arrays.extend(solver.map(|a| (Stage::PressureSolve, a)));
+        arrays
     }
 
     /// Summation density; walls keep their rest density.
