@@ -2,6 +2,7 @@
 //! counting-sorted by linear cell index (x fastest), so that the 3^D neighbour cells of a
 //! particle are 3^(D−1) contiguous index ranges of the particle arrays.
 
+use crate::memory::ArraySize;
 use std::ops::Range;
 
 #[derive(Clone, Debug)]
@@ -46,6 +47,11 @@ impl<const D: usize> CellList<D> {
     #[inline]
     pub fn cell_of_sorted(&self, k: usize) -> usize {
         self.sorted_cell[k] as usize
+    }
+
+    /// The per-particle array of the grid: the cell of each particle in the sorted order.
+    pub fn sorted_cells(&self) -> ArraySize {
+        ArraySize::of("cell of sorted particle", &self.sorted_cell)
     }
 
     pub fn cell_count(&self) -> usize {

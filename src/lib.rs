@@ -10,6 +10,7 @@ pub mod io;
 pub mod kernel;
 pub mod lattice;
 pub mod linsolve;
+pub mod memory;
 pub mod multigrid;
 pub mod neighbours;
 pub mod particles;

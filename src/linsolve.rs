@@ -1,6 +1,7 @@
 //! Matrix-free Krylov solver: BiCGSTAB (van der Vorst 1992) with right preconditioning,
 //! against small linear-operator and preconditioner traits. It knows nothing of particles.
 
+use crate::memory::ArraySize;
 use crate::reduce::{dot, fill};
 use rayon::prelude::*;
 
@@ -87,8 +88,29 @@ fn norm(a: &[f64]) -> f64 {
 }
 
 impl BiCgStab {
-    /// Bytes held per unknown (eight vectors of f64).
-    pub const BYTES_PER_UNKNOWN: usize = 8 * 8;
+    /// The work vectors, one entry per unknown each.
+    pub fn arrays(&self) -> Vec<ArraySize> {
+        let BiCgStab {
+            r,
+            r_hat,
+            p,
+            v,
+            s,
+            t,
+            p_hat,
+            s_hat,
+        } = self;
+        vec![
+            ArraySize::of("BiCGSTAB r", r),
+            ArraySize::of("BiCGSTAB r̂", r_hat),
+            ArraySize::of("BiCGSTAB p", p),
+            ArraySize::of("BiCGSTAB v", v),
+            ArraySize::of("BiCGSTAB s", s),
+            ArraySize::of("BiCGSTAB t", t),
+            ArraySize::of("BiCGSTAB p̂", p_hat),
+            ArraySize::of("BiCGSTAB ŝ", s_hat),
+        ]
+    }
 
     fn resize(&mut self, n: usize) {
         for v in [

@@ -180,7 +180,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Plan { scene } => {
             let scene = Scene::load(&scene)?;
-            println!("{}", Plan::new(&scene));
+            println!("{}", Plan::new(&scene)?);
             Ok(())
         }
     }

@@ -14,6 +14,7 @@
 //! and every sum runs in a fixed order: the result does not depend on the thread count.
 
 use crate::linsolve::{inverse_diagonal, LinearOperator, Preconditioner, SolverError};
+use crate::memory::ArraySize;
 use crate::reduce::fill;
 
 /// Damping of the Jacobi smoother.
@@ -194,6 +195,24 @@ pub struct Multigrid<const D: usize> {
 }
 
 impl<const D: usize> Multigrid<D> {
+    /// The arrays of the fine level, one entry per unknown each (the coarser levels hold one
+    /// entry per cell).
+    pub fn fine_arrays(&self) -> Vec<ArraySize> {
+        let Multigrid {
+            fine_inv_diag,
+            fine_cell,
+            fine_residual,
+            fine_product,
+            levels: _,
+        } = self;
+        vec![
+            ArraySize::of("multigrid D⁻¹", fine_inv_diag),
+            ArraySize::of("multigrid aggregate", fine_cell),
+            ArraySize::of("multigrid residual", fine_residual),
+            ArraySize::of("multigrid A z", fine_product),
+        ]
+    }
+
     /// Builds the hierarchy for operator `a`.
     pub fn build(&mut self, a: &impl Aggregated<D>) -> Result<(), SolverError> {
         let n = a.len();

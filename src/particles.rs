@@ -53,6 +53,19 @@ pub enum ArrayMut<'a> {
     Kind(&'a mut Vec<Kind>),
 }
 
+impl ArrayMut<'_> {
+    /// Bytes per particle of the array.
+    pub fn element_bytes(&self) -> usize {
+        match self {
+            ArrayMut::F64(_) => size_of::<f64>(),
+            ArrayMut::U64(_) => size_of::<u64>(),
+            ArrayMut::U16(_) => size_of::<u16>(),
+            ArrayMut::U8(_) => size_of::<u8>(),
+            ArrayMut::Kind(_) => size_of::<Kind>(),
+        }
+    }
+}
+
 /// Everything needed to create one particle.
 #[derive(Clone, Copy, Debug)]
 pub struct NewParticle<const D: usize> {

@@ -1,20 +1,22 @@
-//! What a scene will run: the stages of a step in order, the particle counts, and the memory
-//! the arrays of those stages take.
+//! What a scene will run: the stages of a step in order (only those of the effects the scene
+//! asks for), the particle counts, and the memory the arrays of each stage take. The byte
+//! counts come from the arrays themselves (`Simulation::arrays`, `Particles::arrays_mut`), so
+//! the plan and the step cannot disagree.
 
-use crate::free_surface::Support;
-use crate::lattice;
-use crate::linsolve::BiCgStab;
-use crate::particles::Kind;
-use crate::scene::Scene;
+use crate::scene::{Effects, Scene};
+use crate::simulation::{NoFluid, Simulation};
+use crate::step;
+use crate::timings::Stage;
+use crate::{lattice, particles::Kind};
 use std::fmt;
-use std::mem::size_of;
 
 /// One stage of the time step.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Stage {
-    pub name: &'static str,
-    pub what: &'static str,
-    /// Per-particle bytes of the arrays this stage owns.
+pub struct PlannedStage {
+    pub stage: Stage,
+    /// What it computes, with the scene's constants.
+    pub what: String,
+    /// Per-particle bytes of the arrays this stage allocates.
     pub bytes_per_particle: usize,
 }
 
@@ -26,113 +28,171 @@ pub struct Plan {
     pub wall_particles: usize,
     pub smoothing_length: f64,
     pub wall_layers: usize,
-    pub stages: Vec<Stage>,
+    pub effects: Effects,
+    /// Per-particle bytes of the particle state (position, velocity, …).
+    pub state_bytes_per_particle: usize,
+    pub stages: Vec<PlannedStage>,
 }
 
 impl Plan {
-    pub fn new(scene: &Scene) -> Plan {
-        let kinds = match scene.dimensions {
-            2 => lattice::build::<2>(scene).kind,
-            _ => lattice::build::<3>(scene).kind,
-        };
-        let fluid = kinds.iter().filter(|&&k| k == Kind::Fluid).count();
-        let d = scene.dimensions;
-        let f64s = |n: usize| 8 * n;
-        let support = if d == 2 {
-            size_of::<Support<2>>()
-        } else {
-            size_of::<Support<3>>()
-        };
-        let stages = vec![
-            Stage {
-                name: "particles",
-                what: "SoA state: position, velocity, wall normal, pressure, density, mass, ρ0, ν, kind, fluid, id",
-                bytes_per_particle: f64s(3 * d + 5) + 1 + 2 + 8,
-            },
-            Stage {
-                name: "cell list",
-                what: "counting sort by cell (x fastest), all arrays permuted together",
-                bytes_per_particle: 4 + 4 + 8,
-            },
-            Stage {
-                name: "density + free surface",
-                what: "summation density; λ_min of the moment matrix, normal and scan region (Marrone et al. 2010) ⇒ free surface (Robin row, P = 0 half a spacing out)",
-                bytes_per_particle: f64s(1) + support + 2,
-            },
-            Stage {
-                name: "kernel correction",
-                what: "L_i of Eq. (25) and L'_i of the pressure gradient (walls as Neumann ghosts) once per step, shared by every corrected operator",
-                bytes_per_particle: 2 * f64s(d * d + 1),
-            },
-            Stage {
-                name: "predictor",
-                what: "Eq. (5): u* = u + Δt (∇·((ν + ν_t)∇u) (Eq. 26, Smagorinsky ν_t Eq. 3–4) + g)",
-                bytes_per_particle: f64s(d + 1),
-            },
-            Stage {
-                name: "pressure Poisson equation",
-                what: "Eq. (6) source, Eq. (27) Laplacian (first-order consistent) matrix-free in BiCGSTAB + Jacobi, warm start; walls: ghosts of the fluid pressure under the Neumann condition (no unknowns); free surface: Robin row",
-                bytes_per_particle: f64s(2 + d) + 1 + BiCgStab::BYTES_PER_UNKNOWN,
-            },
-            Stage { name: "corrector", what: "Eq. (7) with the corrected gradient (Eq. 20, 24–25); no velocity into a wall within dx of it", bytes_per_particle: f64s(d) },
-            Stage {
-                name: "advection + shifting",
-                what: "Eq. (8): r += Δt u, then Fickian shifting δr = −D∇C with u and P Taylor-corrected (Eq. 9–10)",
-                bytes_per_particle: f64s(d),
-            },
-            Stage {
-                name: "diagnostics",
-                what: "max speed, kinetic energy, density error, penetrations → stats.csv",
-                bytes_per_particle: 0,
-            },
-        ];
-        Plan {
+    /// The plan of `scene`; an error where it holds no fluid particle (it cannot run).
+    pub fn new(scene: &Scene) -> Result<Plan, NoFluid> {
+        match scene.dimensions {
+            2 => Self::in_dimension::<2>(scene),
+            _ => Self::in_dimension::<3>(scene),
+        }
+    }
+
+    fn in_dimension<const D: usize>(scene: &Scene) -> Result<Plan, NoFluid> {
+        let mut sim = Simulation::<D>::new(scene)?;
+        let arrays = sim.arrays();
+        let stages = step::stages(&scene.effects)
+            .into_iter()
+            .map(|stage| PlannedStage {
+                stage,
+                what: describe(stage, scene),
+                bytes_per_particle: arrays
+                    .iter()
+                    .filter(|(s, _)| *s == stage)
+                    .map(|(_, a)| a.bytes_per_particle)
+                    .sum(),
+            })
+            .collect();
+        let p = &mut sim.particles;
+        let fluid = p.kind.iter().filter(|&&k| k == Kind::Fluid).count();
+        let (total, state) = (p.len(), p.arrays_mut());
+        Ok(Plan {
             scene: scene.name.clone(),
-            dimensions: d,
+            dimensions: D,
             fluid_particles: fluid,
-            wall_particles: kinds.len() - fluid,
+            wall_particles: total - fluid,
             smoothing_length: scene.smoothing_length(),
             wall_layers: lattice::wall_layers(scene),
+            effects: scene.effects,
+            state_bytes_per_particle: state.iter().map(|(_, a)| a.element_bytes()).sum(),
             stages,
-        }
+        })
     }
 
     pub fn particles(&self) -> usize {
         self.fluid_particles + self.wall_particles
     }
 
+    /// The particle state and the arrays of every stage.
     pub fn bytes_per_particle(&self) -> usize {
-        self.stages.iter().map(|s| s.bytes_per_particle).sum()
+        self.state_bytes_per_particle
+            + self
+                .stages
+                .iter()
+                .map(|s| s.bytes_per_particle)
+                .sum::<usize>()
     }
+}
+
+/// What `stage` computes in `scene`, after the method of `step`, `ppe`, `wall`, `turbulence`,
+/// `shifting` and `multigrid`.
+fn describe(stage: Stage, scene: &Scene) -> String {
+    let effects = &scene.effects;
+    match stage {
+        Stage::CellList => {
+            "counting sort by cell (x fastest), every particle array permuted together".into()
+        }
+        Stage::Density => "summation density ρ_i = Σ_j m_j W_ij; walls keep ρ0".into(),
+        Stage::FreeSurface => "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (Robin row), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".into(),
+        Stage::KernelCorrection => "L_i = M_i⁻¹ (Eq. 24–25) for the divergence and velocity gradients, kept where the free surface is in reach; L'_i for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only); inverted in the free-surface pass from its moments".into(),
+        Stage::EddyViscosity => format!(
+            "Smagorinsky ν_t = (Cs Δ)² |S| (Eq. 3–4), Cs = {}, Δ = dx, walls as free-slip ghosts",
+            effects.les.map_or(0.0, |les| les.cs)
+        ),
+        Stage::Predictor => match effects.les {
+            Some(les) if les.wall_function => "Eq. (5): u* = u + Δt (∇·((ν + ν_t)∇u) (Eq. 26) + τ_w + g), no-slip laminar wall pairs, τ_w the log-law wall shear on the particles touching a wall".into(),
+            Some(_) => "Eq. (5): u* = u + Δt (∇·((ν + ν_t)∇u) (Eq. 26) + g), no-slip laminar wall pairs".into(),
+            None => "Eq. (5): u* = u + Δt (∇·(ν∇u) (Eq. 26) + g), no-slip wall pairs".into(),
+        },
+        Stage::PressureSolve => format!(
+            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: Neumann ghosts of the fluid pressure (no unknowns); free surface: Robin row P + (dx/2) n·∇P = 0; BiCGSTAB preconditioned by an aggregation multigrid V-cycle over the cell grid, warm start",
+            if effects.kernel_correction { " (corrected by L_i)" } else { "" },
+            scene.solver.alpha
+        ),
+        Stage::Corrector => format!(
+            "Eq. (7): u = u* − (Δt/ρ0)∇P, ∇P {} with the walls as ghosts; no velocity into a wall within dx",
+            if effects.kernel_correction { "corrected by L'_i (Eq. 20, 24–25)" } else { "of Eq. (20)" }
+        ),
+        Stage::WallPressure => "pressure of the wall particles (output): kernel mean of the ghost pressures of their fluid neighbours".into(),
+        Stage::Shifting => {
+            let s = effects.shifting.unwrap_or_default();
+            format!(
+                "Fickian shifting δr = −D∇C (Eq. 10), D = {} h U Δt, anti-clustering weight R = {}, each component at most {} dx, tangential at the free surface; u and P Taylor-corrected to the new position (Eq. 9)",
+                s.coefficient, s.clustering_weight, s.max_shift
+            )
+        }
+        Stage::Advection => if effects.shifting.is_some() {
+            "Eq. (8): r += Δt u + δr"
+        } else {
+            "Eq. (8): r += Δt u"
+        }
+        .into(),
+        Stage::Diagnostics => "max speed, kinetic energy, density error, penetrations → stats.csv".into(),
+    }
+}
+
+/// The effects of a scene in one line.
+fn effects_line(e: &Effects) -> String {
+    let shifting = match e.shifting {
+        Some(s) => format!(
+            "shifting (A = {}, max {} dx, R = {})",
+            s.coefficient, s.max_shift, s.clustering_weight
+        ),
+        None => "shifting off".into(),
+    };
+    let les = match e.les {
+        Some(l) if l.wall_function => format!("LES (Cs = {}, log-law wall function)", l.cs),
+        Some(l) => format!("LES (Cs = {}, no wall function)", l.cs),
+        None => "LES off".into(),
+    };
+    let correction = if e.kernel_correction {
+        "kernel correction"
+    } else {
+        "kernel correction off"
+    };
+    format!("{shifting}, {les}, {correction}")
 }
 
 impl fmt::Display for Plan {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         let n = self.particles();
+        let mib = |bytes: usize| (bytes * n) as f64 / (1 << 20) as f64;
         writeln!(f, "scene {} ({}D)", self.scene, self.dimensions)?;
         writeln!(
             f,
             "particles: {} fluid + {} wall = {n}   (h = {:.4e} m, {} wall layers)",
             self.fluid_particles, self.wall_particles, self.smoothing_length, self.wall_layers
         )?;
+        writeln!(f, "effects: {}", effects_line(&self.effects))?;
+        writeln!(
+            f,
+            "      {:<25} {:>4} B/particle {:>9.2} MiB  position, velocity, wall normal, pressure, density, mass, ρ0, ν, kind, free surface, fluid, id",
+            "particle state",
+            self.state_bytes_per_particle,
+            mib(self.state_bytes_per_particle),
+        )?;
         writeln!(f, "stages per step:")?;
         for (k, s) in self.stages.iter().enumerate() {
-            let mib = (s.bytes_per_particle * n) as f64 / (1 << 20) as f64;
             writeln!(
                 f,
-                "  {}. {:<26} {:>4} B/particle {:>9.2} MiB  {}",
+                "  {:>2}. {:<25} {:>4} B/particle {:>9.2} MiB  {}",
                 k + 1,
-                s.name,
+                s.stage.name(),
                 s.bytes_per_particle,
-                mib,
+                mib(s.bytes_per_particle),
                 s.what
             )?;
         }
         let total = self.bytes_per_particle();
         write!(
             f,
-            "memory: {total} B/particle, {:.2} MiB for the particle arrays (plus the cell grid)",
-            (total * n) as f64 / (1 << 20) as f64
+            "memory: {total} B/particle, {:.2} MiB for the particle arrays (plus per-cell arrays: the cell list and the multigrid levels)",
+            mib(total)
         )
     }
 }

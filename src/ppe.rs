@@ -19,7 +19,7 @@ use crate::multigrid::{cell_offset, stencil_slot, Aggregated};
 use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
-use crate::sph::{velocity_gradient, Correction, Neighbours};
+use crate::sph::{velocity_gradient, Correction, Corrections, Neighbours};
 use crate::wall::{behind_walls, ghost_velocity};
 use wide::{f64x4, CmpNe};
 
@@ -44,13 +44,15 @@ impl Role {
 }
 
 /// Assigns roles: fluid on the free surface (see `free_surface`) takes the Robin row, or P = 0
-/// where it has no consistent gradient. If the fluid has no free surface at all (a full closed
-/// box) the PPE is singular; the highest fluid particle is then pinned to P = 0.
+/// where it has no consistent gradient (`gradient_defined` false: the moment matrix of its
+/// pressure gradient is near-singular, whether or not the scene applies the kernel correction).
+/// If the fluid has no free surface at all (a full closed box) the PPE is singular; the highest
+/// fluid particle is then pinned to P = 0.
 pub fn assign_roles<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     supports: &[Support<D>],
-    pressure_corrections: &[Correction<D>],
+    gradient_defined: &[bool],
     gravity: [f64; D],
     roles: &mut Vec<Role>,
 ) {
@@ -60,7 +62,7 @@ pub fn assign_roles<const D: usize>(
             let mut fluid_neighbours = 0;
             nb.for_each(i, |j, _, _| fluid_neighbours += p.is_fluid(j) as usize);
             let free = supports[i].is_free_surface(nb, i, p.density[i] / p.rest_density[i]);
-            if fluid_neighbours == 0 || pressure_corrections[i].is_none() {
+            if fluid_neighbours == 0 || !gradient_defined[i] {
                 Role::Splash
             } else if free {
                 Role::Surface
@@ -108,18 +110,18 @@ pub fn row_vectors<const D: usize>(
     p: &Particles<D>,
     roles: &[Role],
     full: &[bool],
-    pressure_corrections: &[Correction<D>],
+    pressure_corrections: Corrections<D>,
     supports: &[Support<D>],
     spacing: f64,
     out: &mut [Vec<f64>; D],
     corrected: &mut Vec<bool>,
 ) {
     fill_vector(out, |i| match roles[i] {
-        Role::Interior => laplacian_correction(nb, p, &pressure_corrections[i], full[i], i),
+        Role::Interior => laplacian_correction(nb, p, pressure_corrections.of(i), full[i], i),
         Role::Surface => {
             let n = contact_line_normal(nb, p, supports[i].normal, spacing, i);
             let delta = 0.5 * spacing;
-            match &pressure_corrections[i] {
+            match pressure_corrections.of(i) {
                 Some(l) => {
                     std::array::from_fn(|a| delta * (0..D).map(|b| l[b][a] * n[b]).sum::<f64>())
                 }
@@ -168,7 +170,7 @@ fn contact_line_normal<const D: usize>(
 pub fn source<const D: usize>(
     op: &PressureOperator<D>,
     full: &[bool],
-    corrections: &[Correction<D>],
+    corrections: Corrections<D>,
     u_star: &[Vec<f64>; D],
     dt: f64,
     alpha: f64,
@@ -180,7 +182,7 @@ pub fn source<const D: usize>(
         let walls = op.wall_source(i);
         match op.roles[i] {
             Role::Interior => {
-                divergence_source(nb, p, &corrections[i], u_star, full[i], dt, alpha, i) + walls
+                divergence_source(nb, p, corrections.of(i), u_star, full[i], dt, alpha, i) + walls
             }
             Role::Surface | Role::Splash | Role::Wall => walls,
         }

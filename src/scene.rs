@@ -1,6 +1,8 @@
 //! Scene files: TOML in SI units, parsed with unknown keys rejected, then validated into a
 //! `Scene`. Every error names the file, the key and, where it can be found, the line.
 
+use crate::shifting::ShiftingSettings;
+use crate::turbulence::LesSettings;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -37,6 +39,8 @@ struct SceneFile {
     solver: SolverSettings,
     #[serde(default)]
     checkpoint: CheckpointSection,
+    #[serde(default)]
+    effects: EffectsSection,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -111,6 +115,64 @@ struct CheckpointSection {
     keep: Option<i64>,
 }
 
+/// The `[effects]` section as written: each effect a sub-table, every key optional.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EffectsSection {
+    #[serde(default)]
+    shifting: ShiftingSection,
+    #[serde(default)]
+    les: LesSection,
+    #[serde(default)]
+    kernel_correction: KernelCorrectionSection,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ShiftingSection {
+    enabled: Option<bool>,
+    coefficient: Option<f64>,
+    max_shift: Option<f64>,
+    clustering_weight: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LesSection {
+    enabled: Option<bool>,
+    cs: Option<f64>,
+    wall_function: Option<bool>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KernelCorrectionSection {
+    enabled: Option<bool>,
+}
+
+/// The `[effects]` section: which optional parts of the step run, with their constants. Every
+/// effect is on unless the scene turns it off, so a scene without the section runs the full
+/// stabilised scheme.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Effects {
+    /// Particle shifting, Eq. (9)–(10) (None: off).
+    pub shifting: Option<ShiftingSettings>,
+    /// Smagorinsky large-eddy simulation, Eq. (3)–(4) (None: off, laminar viscosity only).
+    pub les: Option<LesSettings>,
+    /// Kernel gradient correction, Eq. (24)–(25) (false: every L_i is the identity).
+    pub kernel_correction: bool,
+}
+
+impl Default for Effects {
+    fn default() -> Self {
+        Self {
+            shifting: Some(ShiftingSettings::default()),
+            les: Some(LesSettings::default()),
+            kernel_correction: true,
+        }
+    }
+}
+
 /// The `[checkpoint]` section: when restart files are written to `OUT/checkpoints/`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CheckpointSettings {
@@ -176,6 +238,7 @@ pub struct Scene {
     pub obstacles: Vec<Aabb>,
     pub solver: SolverSettings,
     pub checkpoint: CheckpointSettings,
+    pub effects: Effects,
 }
 
 impl Scene {
@@ -422,6 +485,7 @@ impl Validator<'_> {
         )?;
 
         let checkpoint = self.checkpoint(&f.checkpoint)?;
+        let effects = self.effects(&f.effects)?;
 
         let name = match &s.name {
             Some(n) => n.clone(),
@@ -445,7 +509,102 @@ impl Validator<'_> {
             obstacles,
             solver: f.solver,
             checkpoint,
+            effects,
         })
+    }
+
+    fn effects(&self, e: &EffectsSection) -> Result<Effects, SceneError> {
+        Ok(Effects {
+            shifting: self.shifting(&e.shifting)?,
+            les: self.les(&e.les)?,
+            kernel_correction: e.kernel_correction.enabled.unwrap_or(true),
+        })
+    }
+
+    /// Whether effect `name` is on (`enabled`, default true); an effect turned off must not be
+    /// given parameters, which it would silently ignore: `given` lists them (key, present).
+    fn enabled(
+        &self,
+        name: &str,
+        enabled: Option<bool>,
+        given: &[(&str, bool)],
+    ) -> Result<bool, SceneError> {
+        let on = enabled.unwrap_or(true);
+        if !on {
+            if let Some((key, _)) = given.iter().find(|(_, present)| *present) {
+                return Err(self.error(
+                    &format!("effects.{name}.{key}"),
+                    format!("is given but `effects.{name}.enabled = false` turns the effect off: remove the key or the `enabled = false`"),
+                ));
+            }
+        }
+        Ok(on)
+    }
+
+    fn shifting(&self, s: &ShiftingSection) -> Result<Option<ShiftingSettings>, SceneError> {
+        let given = [
+            ("coefficient", s.coefficient.is_some()),
+            ("max_shift", s.max_shift.is_some()),
+            ("clustering_weight", s.clustering_weight.is_some()),
+        ];
+        if !self.enabled("shifting", s.enabled, &given)? {
+            return Ok(None);
+        }
+        let default = ShiftingSettings::default();
+        let settings = ShiftingSettings {
+            coefficient: s.coefficient.unwrap_or(default.coefficient),
+            max_shift: s.max_shift.unwrap_or(default.max_shift),
+            clustering_weight: s.clustering_weight.unwrap_or(default.clustering_weight),
+        };
+        self.check(
+            settings.coefficient.is_finite() && settings.coefficient > 0.0,
+            "effects.shifting.coefficient",
+            format!(
+                "= {} must be a positive number (A of D = A h U Δt)",
+                settings.coefficient
+            ),
+        )?;
+        self.check(
+            settings.max_shift > 0.0 && settings.max_shift <= 1.0,
+            "effects.shifting.max_shift",
+            format!(
+                "= {} must lie in (0, 1] [particle spacings]",
+                settings.max_shift
+            ),
+        )?;
+        self.check(
+            settings.clustering_weight.is_finite() && settings.clustering_weight >= 0.0,
+            "effects.shifting.clustering_weight",
+            format!(
+                "= {} must be a non-negative number",
+                settings.clustering_weight
+            ),
+        )?;
+        Ok(Some(settings))
+    }
+
+    fn les(&self, l: &LesSection) -> Result<Option<LesSettings>, SceneError> {
+        let given = [
+            ("cs", l.cs.is_some()),
+            ("wall_function", l.wall_function.is_some()),
+        ];
+        if !self.enabled("les", l.enabled, &given)? {
+            return Ok(None);
+        }
+        let default = LesSettings::default();
+        let settings = LesSettings {
+            cs: l.cs.unwrap_or(default.cs),
+            wall_function: l.wall_function.unwrap_or(default.wall_function),
+        };
+        self.check(
+            settings.cs > 0.0 && settings.cs <= 1.0,
+            "effects.les.cs",
+            format!(
+                "= {} must lie in (0, 1] (to turn LES off, set `effects.les.enabled = false`)",
+                settings.cs
+            ),
+        )?;
+        Ok(Some(settings))
     }
 
     fn checkpoint(&self, c: &CheckpointSection) -> Result<CheckpointSettings, SceneError> {

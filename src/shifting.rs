@@ -13,6 +13,9 @@
 //!   only the part tangential to the surface is kept (normal of `free_surface`).
 //! * Each component is capped at 0.1 dx.
 //!
+//! A, R and the cap are the scene's `[effects.shifting]` (`ShiftingSettings`); the values above
+//! are their defaults.
+//!
 //! Velocity and pressure are then carried to the shifted position by Eq. (9),
 //! φ' = φ + (∇φ)·δr.
 
@@ -20,27 +23,49 @@ use crate::free_surface::Support;
 use crate::particles::Particles;
 use crate::sph::Neighbours;
 
-/// A of D = A h U Δt.
-const DIFFUSION_NUMBER: f64 = 2.0;
-/// R of the anti-clustering term.
-const CLUSTERING_WEIGHT: f64 = 0.2;
-/// Largest shift per component and step, in particle spacings.
-const MAX_SHIFT: f64 = 0.1;
+/// The constants of shifting (the scene's `[effects.shifting]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShiftingSettings {
+    /// A of D = A h U Δt.
+    pub coefficient: f64,
+    /// Largest shift per component and step, in particle spacings.
+    pub max_shift: f64,
+    /// R of the anti-clustering term.
+    pub clustering_weight: f64,
+}
+
+impl Default for ShiftingSettings {
+    fn default() -> Self {
+        Self {
+            coefficient: 2.0,
+            max_shift: 0.1,
+            clustering_weight: 0.2,
+        }
+    }
+}
 
 /// The shifting of one step: D and the reference kernel value W(dx).
 pub struct Shifting {
     diffusion: f64,
     w_dx: f64,
     cap: f64,
+    clustering_weight: f64,
 }
 
 impl Shifting {
     /// Shifting for a step of `dt` with largest fluid speed `max_speed` at spacing `spacing`.
-    pub fn new<const D: usize>(nb: &Neighbours<D>, spacing: f64, max_speed: f64, dt: f64) -> Self {
+    pub fn new<const D: usize>(
+        nb: &Neighbours<D>,
+        settings: &ShiftingSettings,
+        spacing: f64,
+        max_speed: f64,
+        dt: f64,
+    ) -> Self {
         Self {
-            diffusion: DIFFUSION_NUMBER * nb.kernel.h() * max_speed * dt,
+            diffusion: settings.coefficient * nb.kernel.h() * max_speed * dt,
             w_dx: nb.kernel.w(spacing),
-            cap: MAX_SHIFT * spacing,
+            cap: settings.max_shift * spacing,
+            clustering_weight: settings.clustering_weight,
         }
     }
 
@@ -58,7 +83,7 @@ impl Shifting {
         nb.for_each(i, |j, rij, r| {
             let ratio = nb.kernel.w(r) / self.w_dx;
             let c = p.mass[j] / p.rest_density[j]
-                * (1.0 + CLUSTERING_WEIGHT * ratio.powi(4))
+                * (1.0 + self.clustering_weight * ratio.powi(4))
                 * nb.kernel.grad_factor(r);
             for d in 0..D {
                 grad_c[d] += c * rij[d];

@@ -5,6 +5,7 @@ use crate::grid::CellList;
 use crate::kernel::{Quintic, SUPPORT_IN_H};
 use crate::lattice;
 use crate::linsolve::{SolverError, SolverParams};
+use crate::memory::ArraySize;
 use crate::particles::Particles;
 use crate::reduce;
 use crate::scene::{Aabb, Scene};
@@ -116,6 +117,7 @@ impl<const D: usize> Simulation<D> {
                     tolerance: scene.solver.tolerance,
                     max_iterations: scene.solver.max_iterations,
                 },
+                effects: scene.effects,
             },
             container: scene.container.clone(),
             obstacles: scene.obstacles.clone(),
@@ -216,6 +218,7 @@ impl<const D: usize> Simulation<D> {
     }
 
     fn finish_step(&mut self, dt: f64, report: StepReport) -> Result<StepStats, NumericalFailure> {
+        let clock = Instant::now();
         self.step += 1;
         let p = &self.particles;
         let fluid = |i: usize| p.is_fluid(i);
@@ -233,7 +236,7 @@ impl<const D: usize> Simulation<D> {
                 0.0
             }
         });
-        Ok(StepStats {
+        let stats = StepStats {
             step: self.step,
             time: self.time,
             dt,
@@ -243,7 +246,24 @@ impl<const D: usize> Simulation<D> {
             kinetic_energy,
             density_error: report.density_error,
             penetrations: self.penetrations(),
-        })
+        };
+        self.timings.add(Stage::Diagnostics, clock.elapsed());
+        Ok(stats)
+    }
+
+    /// Every per-particle array of the step with the stage that allocates it, as it is now:
+    /// the cell sort's and the workspace's (`Workspace::arrays`). The particles' own arrays are
+    /// `Particles::arrays_mut`.
+    pub fn arrays(&self) -> Vec<(Stage, ArraySize)> {
+        let sort = [
+            ArraySize::of("cell of particle", &self.cell_of),
+            ArraySize::of("sort order", &self.order),
+            ArraySize::of("sort scratch", &self.scratch),
+            self.grid.sorted_cells(),
+        ];
+        let mut arrays: Vec<_> = sort.into_iter().map(|a| (Stage::CellList, a)).collect();
+        arrays.extend(self.work.arrays());
+        arrays
     }
 
     /// Fluid particles whose centre lies inside a wall: outside the container or in an obstacle.

@@ -12,22 +12,23 @@ pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -
     rho
 }
 
-/// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, the eddy viscosity of
-/// the Smagorinsky model (Eq. 3–4). Wall particles are at rest (no-slip) and take the fluid's
-/// laminar viscosity: the turbulent stress at a wall is the law of the wall's
-/// (`turbulence::wall_shear`).
+/// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, ν_t the eddy viscosity
+/// of the Smagorinsky model (Eq. 3–4) where the scene runs LES (`eddy`; None: ν_t = 0). Wall
+/// particles are at rest (no-slip) and take the fluid's laminar viscosity: the turbulent stress
+/// at a wall is the law of the wall's (`turbulence::wall_shear`).
 pub fn viscous_acceleration<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    eddy: &[f64],
+    eddy: Option<&[f64]>,
     i: usize,
 ) -> [f64; D] {
-    let (rho_i, nu_i) = (p.rest_density[i], p.viscosity[i] + eddy[i]);
+    let nu_t = |j: usize| eddy.map_or(0.0, |e| e[j]);
+    let (rho_i, nu_i) = (p.rest_density[i], p.viscosity[i] + nu_t(i));
     let mut acc = [0.0; D];
     nb.for_each(i, |j, _, r| {
         let (nu_i, nu_j) = match p.kind[j] {
             Kind::Wall => (p.viscosity[i], p.viscosity[i]),
-            Kind::Fluid => (nu_i, p.viscosity[j] + eddy[j]),
+            Kind::Fluid => (nu_i, p.viscosity[j] + nu_t(j)),
         };
         let rho_j = p.rest_density[j];
         let c =
@@ -173,6 +174,27 @@ pub fn invert<const D: usize>(mut m: [[f64; D]; D]) -> Option<([[f64; D]; D], f6
 
 /// L_i of Eq. (25), or None where the correction is not applied.
 pub type Correction<const D: usize> = Option<[[f64; D]; D]>;
+
+/// The corrections L_i of every particle, or the identity for all of them where the scene turns
+/// the kernel correction off (then no array of them exists).
+#[derive(Clone, Copy, Debug)]
+pub struct Corrections<'a, const D: usize>(Option<&'a [Correction<D>]>);
+
+impl<'a, const D: usize> Corrections<'a, D> {
+    /// `l` where the correction is `on`, else the identity everywhere.
+    pub fn new(on: bool, l: &'a [Correction<D>]) -> Self {
+        Self(on.then_some(l))
+    }
+
+    /// L_i.
+    #[inline]
+    pub fn of(self, i: usize) -> &'a Correction<D> {
+        match self.0 {
+            Some(l) => &l[i],
+            None => &None,
+        }
+    }
+}
 
 /// Applies L_i to a vector (identity where the correction is off).
 #[inline]

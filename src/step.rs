@@ -1,22 +1,28 @@
 //! One projection step, Eq. (5)–(8), as a sequence of stages over the particles sorted by
-//! cell: summation density → kernel corrections and free surface → predictor → pressure
-//! Poisson equation → corrector → shifting → advection. Each stage reads the particles and
-//! writes its own workspace arrays, which are allocated once and reused; the step then swaps
-//! the new velocity, pressure and density into the particles.
+//! cell: summation density → free surface → kernel corrections → eddy viscosity → predictor →
+//! pressure Poisson equation → corrector → wall pressure → shifting → advection (`stages`).
+//! The stages of the effects a scene turns off (`scene::Effects`) are skipped. Each stage reads
+//! the particles and writes its own workspace arrays, which it allocates when it first runs and
+//! reuses after, so the arrays of a stage that does not run are never allocated
+//! (`Workspace::arrays` lists them all by stage). The step swaps the new velocity, pressure and
+//! density into the particles.
 
 use crate::free_surface::Support;
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::linsolve::{BiCgStab, SolveInfo, SolverError, SolverParams};
+use crate::memory::ArraySize;
 use crate::multigrid::Multigrid;
 use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::{self, fill, fill_vector};
-use crate::shifting::Shifting;
-use crate::sph::{self, Correction, Neighbours};
+use crate::scene::Effects;
+use crate::shifting::{Shifting, ShiftingSettings};
+use crate::sph::{self, Correction, Corrections, Neighbours};
 use crate::timings::{Stage, Timings};
-use crate::turbulence;
+use crate::turbulence::{self, LesSettings};
 use crate::wall;
+use rayon::iter::Either;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -28,6 +34,30 @@ pub struct StepSettings<const D: usize> {
     /// Relaxation α of the density-invariance term of Eq. (6).
     pub alpha: f64,
     pub solver: SolverParams,
+    /// The optional stages and their constants.
+    pub effects: Effects,
+}
+
+/// The stages of a step of a scene with `effects`, in order: those of `Workspace::project`,
+/// with the cell sort before it and the diagnostics after it (run by `Simulation`).
+pub fn stages(effects: &Effects) -> Vec<Stage> {
+    Stage::ALL
+        .into_iter()
+        .filter(|stage| match stage {
+            Stage::KernelCorrection => effects.kernel_correction,
+            Stage::EddyViscosity => effects.les.is_some(),
+            Stage::Shifting => effects.shifting.is_some(),
+            Stage::CellList
+            | Stage::Density
+            | Stage::FreeSurface
+            | Stage::Predictor
+            | Stage::PressureSolve
+            | Stage::Corrector
+            | Stage::WallPressure
+            | Stage::Advection
+            | Stage::Diagnostics => true,
+        })
+        .collect()
 }
 
 /// What a step measured.
@@ -49,12 +79,14 @@ pub struct Workspace<const D: usize> {
     free_surface: Vec<u8>,
     /// No free-surface particle in the kernel support.
     full_support: Vec<bool>,
-    /// Kernel gradient correction L_i of each particle, Eq. (25).
+    /// Whether the moment matrix of the pressure gradient is invertible (`ppe::assign_roles`).
+    gradient_defined: Vec<bool>,
+    /// Kernel gradient correction L_i of each particle, Eq. (25) (with the kernel correction).
     corrections: Vec<Correction<D>>,
     /// The correction L'_i of the pressure gradient, whose wall ghosts carry the normal part
-    /// of the gradient only (see `sph::Moments`).
+    /// of the gradient only (see `sph::Moments`) (with the kernel correction).
     pressure_corrections: Vec<Correction<D>>,
-    /// Smagorinsky eddy viscosity ν_t.
+    /// Smagorinsky eddy viscosity ν_t (with LES).
     eddy: Vec<f64>,
     u_star: [Vec<f64>; D],
     /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
@@ -70,7 +102,7 @@ pub struct Workspace<const D: usize> {
     /// Normal of the wall each fluid particle touches (zero: none).
     contact: [Vec<f64>; D],
     velocity: [Vec<f64>; D],
-    /// Shifting displacement δr of each particle.
+    /// Shifting displacement δr of each particle (with shifting).
     shift: [Vec<f64>; D],
 }
 
@@ -82,6 +114,7 @@ impl<const D: usize> Default for Workspace<D> {
             roles: Vec::new(),
             free_surface: Vec::new(),
             full_support: Vec::new(),
+            gradient_defined: Vec::new(),
             corrections: Vec::new(),
             pressure_corrections: Vec::new(),
             eddy: Vec::new(),
@@ -101,7 +134,8 @@ impl<const D: usize> Default for Workspace<D> {
 }
 
 impl<const D: usize> Workspace<D> {
-    /// Advances the particles (sorted by cell in `grid`) by one step of `dt`.
+    /// Advances the particles (sorted by cell in `grid`) by one step of `dt`, running the
+    /// stages of `stages(&set.effects)` between the cell sort and the diagnostics.
     pub fn project(
         &mut self,
         p: &mut Particles<D>,
@@ -111,7 +145,7 @@ impl<const D: usize> Workspace<D> {
         dt: f64,
         timings: &mut Timings,
     ) -> Result<StepReport, SolverError> {
-        self.resize(p.len());
+        let effects = &set.effects;
         let report = {
             let nb = Neighbours::new(grid, &p.pos, kernel);
             let mut clock = Instant::now();
@@ -123,9 +157,17 @@ impl<const D: usize> Workspace<D> {
             self.summation_density(&nb, p);
             std::mem::swap(&mut p.density, &mut self.density);
             lap(Stage::Density);
-            self.classify(&nb, p, set.gravity);
+            self.classify(&nb, p, set);
             std::mem::swap(&mut p.free_surface, &mut self.free_surface);
             lap(Stage::FreeSurface);
+            if effects.kernel_correction {
+                self.limit_corrections();
+                lap(Stage::KernelCorrection);
+            }
+            if let Some(les) = &effects.les {
+                self.eddy_viscosity(&nb, p, set, les);
+                lap(Stage::EddyViscosity);
+            }
             self.predict(&nb, p, set, dt);
             lap(Stage::Predictor);
             let solve = self.solve_pressure(&nb, p, set, dt)?;
@@ -135,84 +177,150 @@ impl<const D: usize> Workspace<D> {
             std::mem::swap(&mut p.vel, &mut self.velocity);
             let density_error = self.density_error(p);
             lap(Stage::Corrector);
-            self.shift(&nb, p, set, dt);
-            std::mem::swap(&mut p.vel, &mut self.velocity);
+            self.wall_pressure(&nb, p, set.gravity);
             std::mem::swap(&mut p.pressure, &mut self.pressure);
-            lap(Stage::Shifting);
+            lap(Stage::WallPressure);
+            if let Some(shifting) = &effects.shifting {
+                self.shift(&nb, p, set, shifting, dt);
+                std::mem::swap(&mut p.vel, &mut self.velocity);
+                std::mem::swap(&mut p.pressure, &mut self.pressure);
+                lap(Stage::Shifting);
+            }
             StepReport {
                 solve,
                 density_error,
             }
         };
         let clock = Instant::now();
-        self.advect(p, dt);
+        self.advect(p, dt, effects.shifting.is_some());
         timings.add(Stage::Advection, clock.elapsed());
         Ok(report)
     }
 
-    fn resize(&mut self, n: usize) {
-        for a in [
-            &mut self.density,
-            &mut self.eddy,
-            &mut self.fluid_volume,
-            &mut self.rhs,
-        ] {
-            a.resize(n, 0.0);
-        }
-        self.pressure.resize(n, 0.0);
-        for a in self
-            .u_star
-            .iter_mut()
-            .chain(&mut self.row_vectors)
-            .chain(&mut self.contact)
-            .chain(&mut self.velocity)
-            .chain(&mut self.shift)
-        {
-            a.resize(n, 0.0);
-        }
-        self.supports.resize(n, Support::FULL);
-        self.roles.resize(n, Role::Wall);
-        self.free_surface.resize(n, 0);
-        self.full_support.resize(n, false);
-        self.corrections.resize(n, None);
-        self.pressure_corrections.resize(n, None);
+    /// Every per-particle array of the workspace with the stage that allocates it, as it is
+    /// now (the exhaustive destructuring makes leaving out a new field a compile error).
+    pub fn arrays(&self) -> Vec<(Stage, ArraySize)> {
+        let Workspace {
+            density,
+            supports,
+            roles,
+            free_surface,
+            full_support,
+            gradient_defined,
+            corrections,
+            pressure_corrections,
+            eddy,
+            u_star,
+            row_vectors,
+            corrected,
+            fluid_volume,
+            rhs,
+            pressure,
+            bicgstab,
+            multigrid,
+            contact,
+            velocity,
+            shift,
+        } = self;
+        let mut arrays = vec![
+            (Stage::Density, ArraySize::of("density", density)),
+            (Stage::FreeSurface, ArraySize::of("support", supports)),
+            (Stage::FreeSurface, ArraySize::of("PPE role", roles)),
+            (
+                Stage::FreeSurface,
+                ArraySize::of("free surface", free_surface),
+            ),
+            (
+                Stage::FreeSurface,
+                ArraySize::of("full support", full_support),
+            ),
+            (
+                Stage::FreeSurface,
+                ArraySize::of("gradient defined", gradient_defined),
+            ),
+            (Stage::KernelCorrection, ArraySize::of("L", corrections)),
+            (
+                Stage::KernelCorrection,
+                ArraySize::of("L'", pressure_corrections),
+            ),
+            (Stage::EddyViscosity, ArraySize::of("ν_t", eddy)),
+            (Stage::Predictor, ArraySize::of_components("u*", u_star)),
+            (
+                Stage::PressureSolve,
+                ArraySize::of_components("row vector", row_vectors),
+            ),
+            (
+                Stage::PressureSolve,
+                ArraySize::of("corrected row", corrected),
+            ),
+            (
+                Stage::PressureSolve,
+                ArraySize::of("fluid volume", fluid_volume),
+            ),
+            (Stage::PressureSolve, ArraySize::of("right-hand side", rhs)),
+            (Stage::PressureSolve, ArraySize::of("pressure", pressure)),
+            (
+                Stage::Corrector,
+                ArraySize::of_components("contact normal", contact),
+            ),
+            (
+                Stage::Corrector,
+                ArraySize::of_components("velocity", velocity),
+            ),
+            (Stage::Shifting, ArraySize::of_components("δr", shift)),
+        ];
+        let solver = bicgstab.arrays().into_iter().chain(multigrid.fine_arrays());
+        arrays.extend(solver.map(|a| (Stage::PressureSolve, a)));
+        arrays
     }
 
     /// Summation density; walls keep their rest density.
     fn summation_density(&mut self, nb: &Neighbours<D>, p: &Particles<D>) {
+        self.density.resize(p.len(), 0.0);
         fill(&mut self.density, |i| match p.kind[i] {
             Kind::Fluid => sph::density(nb, p, i),
             Kind::Wall => p.rest_density[i],
         });
     }
 
-    /// Kernel gradient corrections, Eq. (25), once per step for every operator below; how each
-    /// support is filled; the free surface and the role of each particle in the PPE.
-    fn classify(&mut self, nb: &Neighbours<D>, p: &Particles<D>, gravity: [f64; D]) {
-        self.corrections
+    /// How each support is filled, from its moments (`sph::support_moments`); the free surface
+    /// and the role of each particle in the PPE. With the kernel correction the corrections
+    /// L_i and L'_i of Eq. (25) are inverted here from the same moments, once per step for
+    /// every operator below.
+    fn classify(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>) {
+        let n = p.len();
+        self.supports.resize(n, Support::FULL);
+        self.gradient_defined.resize(n, false);
+        self.free_surface.resize(n, 0);
+        let corrections = if set.effects.kernel_correction {
+            self.corrections.resize(n, None);
+            self.pressure_corrections.resize(n, None);
+            let pairs = self.corrections.par_iter_mut();
+            Either::Left(pairs.zip(&mut self.pressure_corrections).map(Some))
+        } else {
+            Either::Right((0..n).into_par_iter().map(|_| None))
+        };
+        self.supports
             .par_iter_mut()
-            .zip(&mut self.pressure_corrections)
-            .zip(&mut self.supports)
+            .zip(&mut self.gradient_defined)
+            .zip(corrections)
             .enumerate()
-            .for_each(|(i, ((l, lp), support))| {
-                (*l, *lp, *support) = match p.kind[i] {
-                    Kind::Fluid => {
-                        let mo = sph::support_moments(nb, p, i);
-                        (
-                            sph::gradient_correction(mo.m),
-                            sph::gradient_correction(mo.m_neumann),
-                            Support::new(&mo.m, mo.grad_c),
-                        )
-                    }
-                    Kind::Wall => (None, None, Support::FULL),
+            .for_each(|(i, ((support, defined), corrections))| {
+                let mo = p.is_fluid(i).then(|| sph::support_moments(nb, p, i));
+                let l_pressure = mo.and_then(|mo| sph::gradient_correction(mo.m_neumann));
+                *support = mo.map_or(Support::FULL, |mo| Support::new(&mo.m, mo.grad_c));
+                *defined = l_pressure.is_some();
+                if let Some((l, lp)) = corrections {
+                    *l = mo.and_then(|mo| sph::gradient_correction(mo.m));
+                    *lp = l_pressure;
                 }
             });
         ppe::assign_roles(
             nb,
             p,
             &self.supports,
-            &self.pressure_corrections,
-            gravity,
+            &self.gradient_defined,
+            set.gravity,
             &mut self.roles,
         );
         ppe::full_support(nb, &self.roles, &mut self.full_support);
@@ -221,11 +329,15 @@ impl<const D: usize> Workspace<D> {
             Role::Splash => 2,
             Role::Interior | Role::Wall => 0,
         });
-        // Inside the fluid (no free surface in reach) the moment matrix measures the disorder of
-        // the particles, not a truncated support: corrected there, the divergence of the PPE
-        // source amplifies that disorder into the pressure (measured: a collision of two blocks
-        // gains energy instead of losing it). The pressure gradient keeps its correction, which
-        // there corrects the wall ghosts' missing tangential gradient.
+    }
+
+    /// Inside the fluid (no free surface in reach) the moment matrix measures the disorder of
+    /// the particles, not a truncated support: corrected there, the divergence of the PPE
+    /// source amplifies that disorder into the pressure (measured: a collision of two blocks
+    /// gains energy instead of losing it). So L_i is kept only where the free surface is in
+    /// reach. The pressure gradient keeps its correction L'_i everywhere, which inside the fluid
+    /// corrects the wall ghosts' missing tangential gradient.
+    fn limit_corrections(&mut self) {
         self.corrections
             .par_iter_mut()
             .zip(&self.full_support)
@@ -236,19 +348,42 @@ impl<const D: usize> Workspace<D> {
             });
     }
 
-    /// Predictor, Eq. (5): u* = uⁿ + Δt (∇·((ν + ν_t)∇uⁿ) + τ_w + g), with ν_t the Smagorinsky
-    /// eddy viscosity (Eq. 3–4) and τ_w the turbulent wall shear; walls stay at rest.
-    fn predict(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
-        let (corrections, spacing, gravity) = (&self.corrections, set.spacing, set.gravity);
+    /// The Smagorinsky eddy viscosity ν_t of Eq. (3)–(4), Δ = dx.
+    fn eddy_viscosity(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        les: &LesSettings,
+    ) {
+        self.eddy.resize(p.len(), 0.0);
+        let corrections = Corrections::new(set.effects.kernel_correction, &self.corrections);
         fill(&mut self.eddy, |i| match p.kind[i] {
-            Kind::Fluid => turbulence::eddy_viscosity(nb, p, &corrections[i], spacing, i),
+            Kind::Fluid => {
+                turbulence::eddy_viscosity(nb, p, corrections.of(i), les.cs, set.spacing, i)
+            }
             Kind::Wall => 0.0,
         });
-        let eddy = &self.eddy;
+    }
+
+    /// Predictor, Eq. (5): u* = uⁿ + Δt (∇·((ν + ν_t)∇uⁿ) + τ_w + g), with ν_t the Smagorinsky
+    /// eddy viscosity (Eq. 3–4) and τ_w the turbulent wall shear where the scene runs LES (and
+    /// its wall function); walls stay at rest.
+    fn predict(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
+        for a in &mut self.u_star {
+            a.resize(p.len(), 0.0);
+        }
+        let (spacing, gravity, les) = (set.spacing, set.gravity, set.effects.les);
+        let eddy = les.is_some().then_some(&self.eddy[..]);
+        let wall_function = les.is_some_and(|les| les.wall_function);
         fill_vector(&mut self.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
                 let visc = sph::viscous_acceleration(nb, p, eddy, i);
-                let wall = turbulence::wall_shear(nb, p, spacing, i);
+                let wall = if wall_function {
+                    turbulence::wall_shear(nb, p, spacing, i)
+                } else {
+                    [0.0; D]
+                };
                 std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + wall[d] + gravity[d]))
             }
             Kind::Wall => [0.0; D],
@@ -264,12 +399,19 @@ impl<const D: usize> Workspace<D> {
         set: &StepSettings<D>,
         dt: f64,
     ) -> Result<SolveInfo, SolverError> {
+        let n = p.len();
+        for a in &mut self.row_vectors {
+            a.resize(n, 0.0);
+        }
+        self.fluid_volume.resize(n, 0.0);
+        self.pressure.resize(n, 0.0);
+        let kernel_correction = set.effects.kernel_correction;
         ppe::row_vectors(
             nb,
             p,
             &self.roles,
             &self.full_support,
-            &self.pressure_corrections,
+            Corrections::new(kernel_correction, &self.pressure_corrections),
             &self.supports,
             set.spacing,
             &mut self.row_vectors,
@@ -294,7 +436,7 @@ impl<const D: usize> Workspace<D> {
         ppe::source(
             &op,
             &self.full_support,
-            &self.corrections,
+            Corrections::new(kernel_correction, &self.corrections),
             &self.u_star,
             dt,
             set.alpha,
@@ -317,15 +459,19 @@ impl<const D: usize> Workspace<D> {
     /// Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls
     /// as ghosts; particles touching a wall keep no velocity into it (`wall::no_penetration`).
     fn correct(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
+        for a in self.contact.iter_mut().chain(&mut self.velocity) {
+            a.resize(p.len(), 0.0);
+        }
         fill_vector(&mut self.contact, |i| match p.kind[i] {
             Kind::Fluid => wall::contact_normal(nb, p, set.spacing, i),
             Kind::Wall => [0.0; D],
         });
         let (u_star, contact) = (&self.u_star, &self.contact);
-        let corrections = &self.pressure_corrections;
+        let corrections =
+            Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         fill_vector(&mut self.velocity, |i| match p.kind[i] {
             Kind::Fluid => {
-                let grad = pressure_gradient(nb, p, set.gravity, &corrections[i], i);
+                let grad = pressure_gradient(nb, p, set.gravity, corrections.of(i), i);
                 let rho0 = p.rest_density[i];
                 let u = std::array::from_fn(|d| u_star[d][i] - dt * grad[d] / rho0);
                 wall::no_penetration(u, vector(contact, i))
@@ -351,12 +497,32 @@ impl<const D: usize> Workspace<D> {
         sum / n_full as f64
     }
 
+    /// The pressures of the wall particles, for output and wall loads: the ghost pressures
+    /// their fluid neighbours give them (`wall::wall_pressure`). Left with the fluid pressures
+    /// in `self.pressure`.
+    fn wall_pressure(&mut self, nb: &Neighbours<D>, p: &Particles<D>, gravity: [f64; D]) {
+        fill(&mut self.pressure, |i| match p.kind[i] {
+            Kind::Fluid => p.pressure[i],
+            Kind::Wall => wall::wall_pressure(nb, p, gravity, i),
+        });
+    }
+
     /// Particle shifting δr = −D ∇C (Eq. 10) at rⁿ, then velocity and pressure carried to the
     /// shifted position by Eq. (9); the new velocity and pressure are left in `self.velocity`
-    /// and `self.pressure` (walls: the pressure their fluid neighbours give them).
-    fn shift(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
+    /// and `self.pressure`.
+    fn shift(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        settings: &ShiftingSettings,
+        dt: f64,
+    ) {
+        for a in &mut self.shift {
+            a.resize(p.len(), 0.0);
+        }
         let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
-        let shifting = Shifting::new(nb, set.spacing, max_speed, dt);
+        let shifting = Shifting::new(nb, settings, set.spacing, max_speed, dt);
         let (roles, supports, full, contact) = (
             &self.roles,
             &self.supports,
@@ -372,7 +538,8 @@ impl<const D: usize> Workspace<D> {
             }
             Role::Splash | Role::Wall => [0.0; D],
         });
-        let (shift, corrections) = (&self.shift, &self.corrections);
+        let shift = &self.shift;
+        let corrections = Corrections::new(set.effects.kernel_correction, &self.corrections);
         fill_vector(&mut self.velocity, |i| match p.kind[i] {
             Kind::Fluid => {
                 // Where the free surface is in reach the velocity gradient is no longer that of
@@ -384,7 +551,7 @@ impl<const D: usize> Workspace<D> {
                 let g = sph::velocity_gradient(
                     nb,
                     p,
-                    &corrections[i],
+                    corrections.of(i),
                     |j| sph::fluid_velocity(p, i, j),
                     i,
                 );
@@ -393,28 +560,30 @@ impl<const D: usize> Workspace<D> {
             }
             Kind::Wall => [0.0; D],
         });
-        let pressure_corrections = &self.pressure_corrections;
+        let pressure_corrections =
+            Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         fill(&mut self.pressure, |i| match p.kind[i] {
             Kind::Fluid => {
-                let g = pressure_gradient(nb, p, set.gravity, &pressure_corrections[i], i);
+                let g = pressure_gradient(nb, p, set.gravity, pressure_corrections.of(i), i);
                 let dr = vector(shift, i);
                 (p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>()).max(0.0)
             }
-            Kind::Wall => wall::wall_pressure(nb, p, set.gravity, i),
+            Kind::Wall => p.pressure[i],
         });
     }
 
-    /// Advection, Eq. (8), plus the shift.
-    fn advect(&self, p: &mut Particles<D>, dt: f64) {
+    /// Advection, Eq. (8), plus the shift of the step when shifting ran.
+    fn advect(&self, p: &mut Particles<D>, dt: f64, shifted: bool) {
         for d in 0..D {
             let (kind, vel, shift) = (&p.kind, &p.vel[d], &self.shift[d]);
             p.pos[d]
                 .par_iter_mut()
                 .zip(vel)
                 .zip(kind)
-                .zip(shift)
-                .for_each(|(((x, v), k), s)| {
+                .enumerate()
+                .for_each(|(i, ((x, v), k))| {
                     if *k == Kind::Fluid {
+                        let s = if shifted { shift[i] } else { 0.0 };
                         *x += dt * v + s;
                     }
                 });

@@ -12,12 +12,31 @@
 //! and τ_w = ρ u_τ². The laminar viscous term already applies ν U/y-like friction through the
 //! no-slip wall pairs of Eq. (26); the turbulent excess u_τ² − ν U/y acts on the layer of
 //! particles touching the wall (thickness dx), against their velocity along it.
+//!
+//! Cs and whether the wall function applies are the scene's `[effects.les]` (`LesSettings`).
 
 use crate::particles::Particles;
 use crate::sph::{fluid_velocity, velocity_gradient, Correction, Neighbours};
 
-/// Smagorinsky constant Cs of Eq. (3)–(4) (the paper's value; DualSPHysics uses 0.12).
-pub const SMAGORINSKY: f64 = 0.2;
+/// The constants of the turbulence model (the scene's `[effects.les]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LesSettings {
+    /// Smagorinsky constant Cs of Eq. (3)–(4).
+    pub cs: f64,
+    /// Whether the particles touching a wall feel the log-law wall shear (`wall_shear`).
+    pub wall_function: bool,
+}
+
+impl Default for LesSettings {
+    /// Cs = 0.2, the paper's value (DualSPHysics uses 0.12), with the wall function.
+    fn default() -> Self {
+        Self {
+            cs: 0.2,
+            wall_function: true,
+        }
+    }
+}
+
 /// von Kármán constant κ.
 const KARMAN: f64 = 0.41;
 /// Additive constant B of the log law for a smooth wall.
@@ -31,10 +50,11 @@ pub fn eddy_viscosity<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Correction<D>,
+    cs: f64,
     spacing: f64,
     i: usize,
 ) -> f64 {
-    let cs_delta = SMAGORINSKY * spacing;
+    let cs_delta = cs * spacing;
     let grad = velocity_gradient(nb, p, l, |j| fluid_velocity(p, i, j), i);
     let mut ss = 0.0;
     for a in 0..D {

@@ -6,6 +6,7 @@ mod bad_input;
 mod checkpoint;
 mod dam_break;
 mod determinism;
+mod effects;
 mod free_surface;
 mod hydrostatic;
 mod kernel;

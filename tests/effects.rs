@@ -1,0 +1,292 @@
+//! Effects (issue 3, item 6): a scene runs only the stages of the effects it asks for and
+//! allocates only their arrays, `isph plan` says so, parameters of an effect that is off are
+//! refused, and a scene without `[effects]` runs as before.
+
+use crate::common::{run_scene, TempDir};
+use isph::plan::Plan;
+use isph::scene::Scene;
+use isph::simulation::Simulation;
+use isph::timings::Stage;
+use std::path::Path;
+
+/// A 10 × 10 block of water in a 20 × 15 box, then `effects` appended.
+fn scene_text(effects: &str) -> String {
+    format!(
+        r#"[simulation]
+dimensions = 2
+spacing = 0.02
+end_time = 0.2
+output_interval = 0.02
+gravity = [0.0, -9.81]
+
+[[fluid]]
+name = "water"
+density = 1000.0
+viscosity = 1.0e-6
+
+[[fluid_block]]
+fluid = "water"
+min = [0.0, 0.0]
+max = [0.2, 0.2]
+
+[container]
+min = [0.0, 0.0]
+max = [0.4, 0.3]
+{effects}"#
+    )
+}
+
+fn parse(effects: &str) -> Result<Scene, String> {
+    Scene::parse(&scene_text(effects), Path::new("scene.toml")).map_err(|e| e.to_string())
+}
+
+fn scene(effects: &str) -> Scene {
+    parse(effects).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const ALL_OFF: &str = r#"
+[effects.shifting]
+enabled = false
+
+[effects.les]
+enabled = false
+
+[effects.kernel_correction]
+enabled = false
+"#;
+
+/// Runs one step of `scene` and checks that the stages that ran, the arrays the step
+/// allocated and the plan agree; returns the planned stages.
+fn check_plan_against_a_step(scene: &Scene) -> Vec<Stage> {
+    let plan = Plan::new(scene).unwrap();
+    let planned: Vec<Stage> = plan.stages.iter().map(|s| s.stage).collect();
+    let mut sim = Simulation::<2>::new(scene).unwrap();
+    sim.advance_towards(scene.output_interval).unwrap();
+    let n = sim.particles.len();
+    assert_eq!(plan.particles(), n);
+
+    let ran: Vec<Stage> = Stage::ALL
+        .into_iter()
+        .filter(|&s| sim.timings.runs(s) > 0)
+        .collect();
+    assert_eq!(ran, planned, "stages run vs plan");
+    for &s in &ran {
+        assert_eq!(sim.timings.runs(s), 1, "{} ran more than once", s.name());
+    }
+
+    let arrays = sim.arrays();
+    for (stage, a) in &arrays {
+        if planned.contains(stage) {
+            assert_eq!(a.len, n, "{} ({}) not allocated", a.name, stage.name());
+            assert!(a.allocated >= n * a.bytes_per_particle, "{}", a.name);
+        } else {
+            assert_eq!(
+                a.allocated,
+                0,
+                "{} allocated, but {} is not planned",
+                a.name,
+                stage.name()
+            );
+        }
+    }
+    for s in &plan.stages {
+        let allocated: usize = arrays
+            .iter()
+            .filter(|(stage, a)| *stage == s.stage && a.len == n)
+            .map(|(_, a)| a.bytes_per_particle)
+            .sum();
+        assert_eq!(allocated, s.bytes_per_particle, "{}", s.stage.name());
+    }
+    planned
+}
+
+/// Whether the workspace holds an allocated array of this name after a step.
+fn allocated_after_a_step(scene: &Scene, name: &str) -> bool {
+    let mut sim = Simulation::<2>::new(scene).unwrap();
+    sim.advance_towards(scene.output_interval).unwrap();
+    let arrays = sim.arrays();
+    let (_, a) = arrays
+        .iter()
+        .find(|(_, a)| a.name == name)
+        .unwrap_or_else(|| panic!("no array {name}"));
+    a.allocated > 0
+}
+
+#[test]
+fn the_plan_lists_the_stages_and_arrays_a_step_uses() {
+    let optional = [
+        Stage::KernelCorrection,
+        Stage::EddyViscosity,
+        Stage::Shifting,
+    ];
+    let default = check_plan_against_a_step(&scene(""));
+    assert!(optional.iter().all(|s| default.contains(s)));
+
+    let cases = [
+        ("[effects.les]\nenabled = false\n", Stage::EddyViscosity),
+        ("[effects.shifting]\nenabled = false\n", Stage::Shifting),
+        (
+            "[effects.kernel_correction]\nenabled = false\n",
+            Stage::KernelCorrection,
+        ),
+    ];
+    for (effects, off) in cases {
+        let stages = check_plan_against_a_step(&scene(effects));
+        let expected: Vec<Stage> = default.iter().copied().filter(|&s| s != off).collect();
+        assert_eq!(stages, expected, "{effects}");
+    }
+    let all_off = check_plan_against_a_step(&scene(ALL_OFF));
+    assert!(optional.iter().all(|s| !all_off.contains(s)));
+
+    let no_wall_function = scene("[effects.les]\nwall_function = false\n");
+    assert_eq!(check_plan_against_a_step(&no_wall_function), default);
+}
+
+#[test]
+fn an_effect_that_is_off_allocates_no_array() {
+    let cases = [
+        ("les", "ν_t"),
+        ("shifting", "δr"),
+        ("kernel_correction", "L"),
+        ("kernel_correction", "L'"),
+    ];
+    for (effect, array) in cases {
+        assert!(allocated_after_a_step(&scene(""), array), "{array}");
+        let off = scene(&format!("[effects.{effect}]\nenabled = false\n"));
+        assert!(
+            !allocated_after_a_step(&off, array),
+            "{array} with {effect} off"
+        );
+    }
+}
+
+#[test]
+fn the_plan_prints_the_stages_in_order_with_their_memory() {
+    for effects in ["", ALL_OFF] {
+        let plan = Plan::new(&scene(effects)).unwrap();
+        let text = plan.to_string();
+        // Stage lines: "  3. free surface   44 B/particle  0.18 MiB  what …".
+        let printed: Vec<(String, usize)> = text
+            .lines()
+            .filter_map(|l| l.trim_start().split_once(". "))
+            .filter(|(k, _)| k.parse::<usize>().is_ok())
+            .map(|(_, rest)| {
+                let (name, rest) = rest.split_once("  ").unwrap();
+                let bytes = rest.split_whitespace().next().unwrap().parse().unwrap();
+                (name.to_string(), bytes)
+            })
+            .collect();
+        let planned: Vec<(String, usize)> = plan
+            .stages
+            .iter()
+            .map(|s| (s.stage.name().to_string(), s.bytes_per_particle))
+            .collect();
+        assert_eq!(printed, planned, "{text}");
+        let total = format!("memory: {} B/particle", plan.bytes_per_particle());
+        assert!(text.contains(&total), "{text}");
+    }
+    let text = Plan::new(&scene(ALL_OFF)).unwrap().to_string();
+    assert!(
+        text.contains("effects: shifting off, LES off, kernel correction off"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_parameter_of_an_effect_that_is_off_is_refused_with_its_key_and_line() {
+    // The effects start on line 21 of the scene text: the parameter is on line 23.
+    let cases = [
+        ("les", "cs = 0.1", "effects.les.cs"),
+        ("les", "wall_function = true", "effects.les.wall_function"),
+        (
+            "shifting",
+            "coefficient = 2.0",
+            "effects.shifting.coefficient",
+        ),
+        ("shifting", "max_shift = 0.1", "effects.shifting.max_shift"),
+        (
+            "shifting",
+            "clustering_weight = 0.2",
+            "effects.shifting.clustering_weight",
+        ),
+    ];
+    for (effect, parameter, key) in cases {
+        let effects = format!("[effects.{effect}]\nenabled = false\n{parameter}\n");
+        let e = parse(&effects).expect_err(&effects);
+        assert!(e.contains(&format!("scene.toml:23: `{key}`")), "{e}");
+        assert!(e.contains("enabled = false"), "{e}");
+    }
+}
+
+#[test]
+fn bad_effect_values_and_keys_are_refused() {
+    let cases = [
+        (
+            "[effects.les]\ncs = 0.0\n",
+            "scene.toml:22: `effects.les.cs`",
+        ),
+        ("[effects.les]\ncs = 0.0\n", "enabled = false"),
+        (
+            "[effects.shifting]\ncoefficient = -1.0\n",
+            "scene.toml:22: `effects.shifting.coefficient`",
+        ),
+        (
+            "[effects.shifting]\nmax_shift = 2.0\n",
+            "scene.toml:22: `effects.shifting.max_shift`",
+        ),
+        (
+            "[effects.shifting]\nclustering_weight = -0.1\n",
+            "`effects.shifting.clustering_weight`",
+        ),
+        (
+            "[effects.les]\nsmagorinsky = 0.1\n",
+            "unknown field `smagorinsky`",
+        ),
+        ("[effects.les]\nsmagorinsky = 0.1\n", "line 22"),
+        ("[effects.turbulence]\n", "unknown field `turbulence`"),
+        (
+            "[effects.kernel_correction]\nenabled = \"no\"\n",
+            "invalid type",
+        ),
+    ];
+    for (effects, expected) in cases {
+        let e = parse(effects).expect_err(effects);
+        assert!(e.contains(expected), "`{expected}` missing from: {e}");
+    }
+}
+
+#[test]
+fn a_scene_without_effects_runs_as_with_every_default_spelled_out() {
+    let spelled_out = r#"
+[effects.shifting]
+enabled = true
+coefficient = 2.0
+max_shift = 0.1
+clustering_weight = 0.2
+
+[effects.les]
+enabled = true
+cs = 0.2
+wall_function = true
+
+[effects.kernel_correction]
+enabled = true
+"#;
+    let (default, explicit, off) = (scene(""), scene(spelled_out), scene(ALL_OFF));
+    assert_eq!(default.effects, explicit.effects);
+    assert_eq!(default.content_hash(), explicit.content_hash());
+    assert_ne!(default.content_hash(), off.content_hash());
+
+    let dir = TempDir::new("effects-defaults");
+    let frames = |scene: &Scene, name: &str| {
+        let out = dir.path().join(name);
+        run_scene(scene, &out, scene.end_time);
+        std::fs::read(out.join("particles.h5")).unwrap()
+    };
+    let reference = frames(&default, "default");
+    assert!(reference == frames(&explicit, "explicit"), "frames differ");
+    assert!(
+        reference != frames(&off, "off"),
+        "turning every effect off changed nothing"
+    );
+}
