@@ -288,9 +288,12 @@ pub struct PpeSetup<const D: usize> {
 impl<const D: usize> PpeSetup<D> {
     /// Sorts `p` by cell on a grid around the particles and derives the operator's arrays.
     pub fn new(p: &mut Particles<D>, kernel: Quintic<D>) -> Self {
+        // A support of margin: a particle on the box's face lies in an interior cell.
         let support = kernel.support();
-        let lo = std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MAX, f64::min));
-        let hi = std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MIN, f64::max));
+        let lo =
+            std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MAX, f64::min) - support);
+        let hi =
+            std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MIN, f64::max) + support);
         let mut grid = CellList::new(lo, hi, support);
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
         grid.sort(&p.pos, &mut cells, &mut order)
