@@ -1,75 +1,134 @@
-//! Hot-path benches: neighbour search and the matrix-free PPE apply (pairs/s), 2D and 3D.
+//! Hot-path benches in 2D and 3D, on the dam break of `isph bench` (in 2D its x–z section) a few
+//! steps after the release: the cell sort (particles/s), the pair loop of the summation density
+//! and the PPE operator apply (pair interactions/s), one BiCGSTAB solve with the multigrid
+//! preconditioner of the step (fluid particles/s), and a full `Simulation` step (fluid
+//! particles/s).
+//!
+//! The PPE operator is rebuilt from the state through the public API (`isph::bench::PpeSetup`:
+//! the step's roles, row vectors zero, so each pair costs the step's arithmetic).
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use isph::grid::CellList;
-use isph::kernel::{Quintic, SUPPORT_IN_H};
-use isph::particles::{Kind, NewParticle, Particles};
-use isph::sph::{laplacian_coefficient, Neighbours};
+use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
+use isph::bench::{dam_break_scene, PpeSetup};
+use isph::linsolve::{BiCgStab, LinearOperator, SolverParams};
+use isph::multigrid::Multigrid;
+use isph::particles::Particles;
+use isph::reduce::fill;
+use isph::simulation::Simulation;
+use isph::sph::{self, Neighbours};
+use std::time::Duration;
 
-fn lattice<const D: usize>(n: usize, dx: f64) -> (Particles<D>, CellList<D>, Quintic<D>) {
-    let mut p = Particles::<D>::default();
-    for k in 0..n.pow(D as u32) {
-        let mut rest = k;
-        let pos = std::array::from_fn(|_| {
-            let c = rest % n;
-            rest /= n;
-            (c as f64 + 0.5) * dx
-        });
-        p.push(NewParticle {
-            pos,
-            kind: Kind::Fluid,
-            normal: [0.0; D],
-            fluid: 0,
-            mass: 1000.0 * dx.powi(D as i32),
-            rest_density: 1000.0,
-            viscosity: 0.0,
-        });
+/// Steps taken before the state is benched: past the PPE's cold start from rest.
+const SETTLE_STEPS: usize = 3;
+
+fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
+    let scene = dam_break_scene(D, spacing).unwrap();
+    let mut sim = Simulation::<D>::new(&scene).unwrap();
+    for _ in 0..SETTLE_STEPS {
+        sim.advance_towards(scene.end_time).unwrap();
     }
-    let kernel = Quintic::<D>::new(1.2 * dx);
-    let mut grid = CellList::new([0.0; D], [n as f64 * dx; D], SUPPORT_IN_H * kernel.h());
-    let (mut c, mut o, mut s) = (Vec::new(), Vec::new(), Vec::new());
-    grid.sort(&p.pos, &mut c, &mut o).unwrap();
-    p.permute(&o, &mut s);
-    (p, grid, kernel)
+    let gravity = std::array::from_fn(|d| scene.gravity[d]);
+    let kernel = sim.kernel();
+    // A copy for the operator benches; `sim` goes on for the step bench.
+    let mut p = sim.particles.clone();
+    let setup = PpeSetup::new(&mut p, kernel);
+    let nb = setup.neighbours(&p, kernel);
+    let op = setup.operator(&nb, &p, gravity);
+    let (n, fluid) = (p.len(), p.fluid_count());
+    let label = |what: &str| format!("{what}_{fluid}_fluid_{n}_particles");
+    let mut g = c.benchmark_group(format!("{D}d"));
+
+    g.throughput(Throughput::Elements(n as u64));
+    let mut grid = setup.grid.clone();
+    let (mut cells, mut order) = (Vec::new(), Vec::new());
+    g.bench_function(label("cell_sort"), |b| {
+        b.iter(|| grid.sort(&p.pos, &mut cells, &mut order).unwrap())
+    });
+
+    g.sample_size(50)
+        .throughput(Throughput::Elements(fluid_pairs(&nb, &p) as u64));
+    let mut density = vec![0.0; n];
+    g.bench_function(label("pair_loop_density"), |b| {
+        b.iter(|| {
+            fill(&mut density, |i| {
+                if p.is_fluid(i) {
+                    sph::density(&nb, &p, i)
+                } else {
+                    0.0
+                }
+            })
+        })
+    });
+
+    g.throughput(Throughput::Elements(setup.pairs(&nb) as u64));
+    let x = p.pressure.clone();
+    let mut y = vec![0.0; n];
+    g.bench_function(label("ppe_apply"), |b| b.iter(|| op.apply(&x, &mut y)));
+
+    // A known solution: the hydrostatic pressure under the highest fluid particle.
+    let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
+    let top = (0..n)
+        .filter(|&i| p.is_fluid(i))
+        .map(height)
+        .fold(f64::MIN, f64::max);
+    let exact: Vec<f64> = (0..n)
+        .map(|i| {
+            if p.is_fluid(i) {
+                p.rest_density[i] * (top - height(i))
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut rhs = vec![0.0; n];
+    op.apply(&exact, &mut rhs);
+    let params = SolverParams {
+        tolerance: scene.solver.tolerance,
+        max_iterations: scene.solver.max_iterations,
+    };
+    let (mut solver, mut multigrid, mut solution) =
+        (BiCgStab::default(), Multigrid::<D>::default(), vec![0.0; n]);
+    let info = solver
+        .solve(&op, &mut multigrid, &rhs, &mut solution, params)
+        .unwrap();
+    eprintln!(
+        "{D}d: BiCGSTAB + multigrid from zero to the hydrostatic pressure: {} iterations, relative residual {:.1e}",
+        info.iterations, info.relative_residual
+    );
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .measurement_time(Duration::from_secs(20))
+        .throughput(Throughput::Elements(fluid as u64));
+    g.bench_function(label("bicgstab_solve"), |b| {
+        b.iter(|| {
+            solution.fill(0.0);
+            solver
+                .solve(&op, &mut multigrid, &rhs, &mut solution, params)
+                .unwrap()
+        })
+    });
+
+    g.bench_function(label("step"), |b| {
+        b.iter(|| sim.advance_towards(scene.end_time).unwrap())
+    });
+    g.finish();
 }
 
-fn bench<const D: usize>(c: &mut Criterion, n: usize) {
-    let (p, grid, kernel) = lattice::<D>(n, 0.01);
-    let nb = Neighbours::new(&grid, &p.pos, kernel);
-    let pairs: usize = (0..p.len())
+/// Neighbour pairs of the fluid particles: the pair interactions of the summation density.
+fn fluid_pairs<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>) -> usize {
+    (0..p.len())
+        .filter(|&i| p.is_fluid(i))
         .map(|i| {
             let mut k = 0;
             nb.for_each(i, |_, _, _| k += 1);
             k
         })
-        .sum();
-    let x: Vec<f64> = (0..p.len()).map(|i| (i % 17) as f64).collect();
-    let mut y = vec![0.0; p.len()];
-    let mut g = c.benchmark_group(format!("{D}d"));
-    g.throughput(Throughput::Elements(pairs as u64));
-    g.bench_function(format!("laplacian_apply_{}_particles", p.len()), |b| {
-        b.iter(|| {
-            isph::reduce::fill(&mut y, |i| {
-                let mut s = 0.0;
-                nb.for_each(i, |j, _, r| {
-                    s += laplacian_coefficient(&nb, &p, i, j, r) * (x[i] - x[j])
-                });
-                s
-            })
-        })
-    });
-    let mut grid2 = grid.clone();
-    let (mut cells, mut order) = (Vec::new(), Vec::new());
-    g.throughput(Throughput::Elements(p.len() as u64));
-    g.bench_function(format!("cell_sort_{}_particles", p.len()), |b| {
-        b.iter(|| grid2.sort(&p.pos, &mut cells, &mut order).unwrap())
-    });
-    g.finish();
+        .sum()
 }
 
 fn operators(c: &mut Criterion) {
-    bench::<2>(c, 200);
-    bench::<3>(c, 32);
+    // 60 × 100 fluid particles in 2D, 15 × 20 × 25 in 3D (the spacing of dam_break_3d.toml).
+    bench::<2>(c, 0.005);
+    bench::<3>(c, 0.02);
 }
 
 criterion_group!(benches, operators);

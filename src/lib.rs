@@ -4,6 +4,7 @@
 //! projection step of [`simulation::Simulation`]; [`run`] drives a whole run with its output
 //! and checkpoints, and continues one from a checkpoint ([`resume`]).
 
+pub mod bench;
 pub mod free_surface;
 pub mod grid;
 pub mod io;

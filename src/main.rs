@@ -2,6 +2,7 @@
 
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand};
+use isph::bench::{self, BenchOptions, Schedule};
 use isph::plan::Plan;
 use isph::resume::{self, ResumeOptions};
 use isph::run::{run, RunError, RunOptions, StopSignal};
@@ -68,6 +69,31 @@ enum Command {
     },
     /// Print the stages, particle counts and memory of a scene without running it.
     Plan { scene: PathBuf },
+    /// Time the 3D dam break of scenes/dam_break_3d.toml at several particle counts and thread
+    /// counts: time per step by stage, PPE iterations, pair throughput, peak memory, parallel
+    /// efficiency (docs/performance.md). Each point runs in a process of its own.
+    Bench {
+        /// Wanted fluid-particle counts; each takes the spacing 0.1 m/k (k whole) that comes
+        /// closest.
+        #[arg(long, value_delimiter = ',', default_value = "1e4,1e5,1e6")]
+        sizes: Vec<f64>,
+        /// Thread counts [default: 1 up to the number of cores].
+        #[arg(long, value_delimiter = ',')]
+        threads: Vec<usize>,
+        /// Steps timed at each point.
+        #[arg(long, default_value_t = 3)]
+        steps: usize,
+        /// Untimed steps before them (the first step from rest solves the PPE from zero).
+        #[arg(long, default_value_t = 1)]
+        warmup: usize,
+        /// Also write the results to this CSV file.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Measure the one point given by --sizes and --threads in this process and print it
+        /// as TOML: how `isph bench` runs each point.
+        #[arg(long, hide = true)]
+        child: bool,
+    },
 }
 
 fn main() {
@@ -183,7 +209,43 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             println!("{}", Plan::new(&scene)?);
             Ok(())
         }
+        Command::Bench {
+            sizes,
+            threads,
+            steps,
+            warmup,
+            csv,
+            child,
+        } => {
+            let threads = if threads.is_empty() {
+                bench::default_threads()
+            } else {
+                threads
+            };
+            let opts = BenchOptions::new(&sizes, &threads, Schedule { warmup, steps }, csv)?;
+            if child {
+                return bench_child(&opts);
+            }
+            let exe = std::env::current_exe().context("locating the isph executable")?;
+            let rows = bench::run(&opts, &exe, |line| eprintln!("{line}"))?;
+            print!("{}", bench::table(&rows, opts.schedule));
+            if let Some(csv) = &opts.csv {
+                println!("written: {}", csv.display());
+            }
+            Ok(())
+        }
     }
+}
+
+/// One point of `isph bench`, measured in this process on a pool of the requested size.
+fn bench_child(opts: &BenchOptions) -> anyhow::Result<()> {
+    let (&[size], &[threads]) = (opts.sizes.as_slice(), opts.threads.as_slice()) else {
+        bail!("--child measures one point: give one size and one thread count");
+    };
+    start_threads(Some(threads))?;
+    let m = bench::measure_point(size, opts.schedule)?;
+    print!("{}", m.to_toml());
+    Ok(())
 }
 
 fn start_threads(threads: Option<usize>) -> anyhow::Result<()> {

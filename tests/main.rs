@@ -3,6 +3,7 @@
 mod common;
 
 mod bad_input;
+mod bench;
 mod checkpoint;
 mod dam_break;
 mod determinism;
