@@ -275,14 +275,15 @@ fn time_ppe_apply<const D: usize>(
 ///
 /// The roles come from `Particles::free_surface`, the step's record of them (0 interior or
 /// wall, 1 free surface, 2 splash). The row vectors of the first-order correction and of the
-/// Robin rows are zero: each pair costs the same arithmetic as in the step (the dot product
-/// with a zero vector is still taken), but the rows are the plain Laplacian of Eq. (27), and
-/// the free-surface rows P_i = b_i.
+/// Robin rows are zero and no row carries the consistency correction: every row is the plain
+/// Laplacian of Eq. (27), as the step's interior rows away from walls and the free surface are,
+/// and the free-surface rows P_i = b_i.
 pub struct PpeSetup<const D: usize> {
     pub grid: CellList<D>,
     pub roles: Vec<Role>,
     pub row_vectors: [Vec<f64>; D],
-    pub fluid_mass: Vec<f64>,
+    pub fluid_volume: Vec<f64>,
+    pub corrected: Vec<bool>,
 }
 
 impl<const D: usize> PpeSetup<D> {
@@ -306,16 +307,20 @@ impl<const D: usize> PpeSetup<D> {
             (Kind::Fluid, 2) => Role::Splash,
             (Kind::Fluid, _) => Role::Interior,
         });
-        let mut fluid_mass = vec![0.0; p.len()];
-        fill(
-            &mut fluid_mass,
-            |i| if p.is_fluid(i) { p.mass[i] } else { 0.0 },
-        );
+        let mut fluid_volume = vec![0.0; p.len()];
+        fill(&mut fluid_volume, |i| {
+            if p.is_fluid(i) {
+                p.mass[i] / p.rest_density[i]
+            } else {
+                0.0
+            }
+        });
         Self {
             grid,
             roles,
             row_vectors: std::array::from_fn(|_| vec![0.0; p.len()]),
-            fluid_mass,
+            fluid_volume,
+            corrected: vec![false; p.len()],
         }
     }
 
@@ -334,7 +339,8 @@ impl<const D: usize> PpeSetup<D> {
             p,
             roles: &self.roles,
             row_vectors: &self.row_vectors,
-            fluid_mass: &self.fluid_mass,
+            fluid_volume: &self.fluid_volume,
+            corrected: &self.corrected,
             gravity,
         }
     }
