@@ -33,6 +33,7 @@ pub struct StepStats {
     pub kinetic_energy: f64,
     pub density_error: f64,
     pub penetrations: usize,
+    pub disorder: f64,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -246,6 +247,7 @@ impl<const D: usize> Simulation<D> {
             kinetic_energy,
             density_error: report.density_error,
             penetrations: self.penetrations(),
+            disorder: report.disorder,
         };
         self.timings.add(Stage::Diagnostics, clock.elapsed());
         Ok(stats)

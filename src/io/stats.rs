@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 pub const FILE_NAME: &str = "stats.csv";
 
 pub const HEADER: &str =
-    "step,time,dt,ppe_iterations,ppe_residual,max_speed,kinetic_energy,density_error,penetrations,wall_seconds";
+    "step,time,dt,ppe_iterations,ppe_residual,max_speed,kinetic_energy,density_error,penetrations,wall_seconds,disorder";
 
 pub struct StatsWriter {
     out: BufWriter<File>,
@@ -59,7 +59,7 @@ impl StatsWriter {
     /// One row; `wall_seconds` is the wall-clock time since the run started.
     pub fn row(&mut self, s: &StepStats, wall_seconds: f64) -> Result<(), OutputError> {
         self.line(format_args!(
-            "{},{:e},{:e},{},{:e},{:e},{:e},{:e},{},{:.3}",
+            "{},{:e},{:e},{},{:e},{:e},{:e},{:e},{},{:.3},{:e}",
             s.step,
             s.time,
             s.dt,
@@ -69,7 +69,8 @@ impl StatsWriter {
             s.kinetic_energy,
             s.density_error,
             s.penetrations,
-            wall_seconds
+            wall_seconds,
+            s.disorder
         ))
     }
 
