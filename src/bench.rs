@@ -12,11 +12,11 @@ use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::linsolve::LinearOperator;
 use crate::particles::{Kind, Particles};
-use crate::ppe::{PressureOperator, Role};
+use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::fill;
 use crate::scene::{Scene, SceneError};
 use crate::simulation::{NoFluid, NumericalFailure, Simulation};
-use crate::sph::Neighbours;
+use crate::sph::{Corrections, Neighbours};
 use crate::timings::Stage;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -274,10 +274,9 @@ fn time_ppe_apply<const D: usize>(
 /// through the public API, to time its apply on its own.
 ///
 /// The roles come from `Particles::free_surface`, the step's record of them (0 interior or
-/// wall, 1 free surface, 2 splash). The row vectors of the first-order correction and of the
-/// Robin rows are zero and no row carries the consistency correction: every row is the plain
-/// Laplacian of Eq. (27), as the step's interior rows away from walls and the free surface are,
-/// and the free-surface rows P_i = b_i.
+/// wall, 1 free surface, 2 splash). Every interior row carries the consistency correction, as
+/// in the step, with the uncorrected c_i (the kernel correction's matrices are not rebuilt):
+/// each pair costs the arithmetic it costs in the step.
 pub struct PpeSetup<const D: usize> {
     pub grid: CellList<D>,
     pub roles: Vec<Role>,
@@ -307,6 +306,17 @@ impl<const D: usize> PpeSetup<D> {
             (Kind::Fluid, 2) => Role::Splash,
             (Kind::Fluid, _) => Role::Interior,
         });
+        let mut row_vectors = std::array::from_fn(|_| vec![0.0; p.len()]);
+        let mut corrected = Vec::new();
+        let nb = Neighbours::new(&grid, &p.pos, kernel);
+        ppe::row_vectors(
+            &nb,
+            p,
+            &roles,
+            Corrections::new(false, &[]),
+            &mut row_vectors,
+            &mut corrected,
+        );
         let mut fluid_volume = vec![0.0; p.len()];
         fill(&mut fluid_volume, |i| {
             if p.is_fluid(i) {
@@ -318,9 +328,9 @@ impl<const D: usize> PpeSetup<D> {
         Self {
             grid,
             roles,
-            row_vectors: std::array::from_fn(|_| vec![0.0; p.len()]),
+            row_vectors,
             fluid_volume,
-            corrected: vec![false; p.len()],
+            corrected,
         }
     }
 

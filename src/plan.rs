@@ -98,7 +98,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
             "counting sort by cell (x fastest), every particle array permuted together".into()
         }
         Stage::Density => "summation density ρ_i = Σ_j m_j W_ij; walls keep ρ0".into(),
-        Stage::FreeSurface => "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (Robin row), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".into(),
+        Stage::FreeSurface => "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".into(),
         Stage::KernelCorrection => "L_i = M_i⁻¹ (Eq. 24–25) for the divergence and velocity gradients, kept where the free surface is in reach; L'_i for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only); inverted in the free-surface pass from its moments".into(),
         Stage::EddyViscosity => format!(
             "Smagorinsky ν_t = (Cs Δ)² |S| (Eq. 3–4), Cs = {}, Δ = dx, walls as free-slip ghosts",
@@ -110,7 +110,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
             None => "Eq. (5): u* = u + Δt (∇·(ν∇u) (Eq. 26) + g), no-slip wall pairs".into(),
         },
         Stage::PressureSolve => format!(
-            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: Neumann ghosts of the fluid pressure (no unknowns); free surface: Robin row P + (dx/2) n·∇P = 0; BiCGSTAB preconditioned by an aggregation multigrid V-cycle over the cell grid, warm start",
+            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: Neumann ghosts of the fluid pressure (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by an aggregation multigrid V-cycle over the cell grid, warm start",
             if effects.kernel_correction { " (corrected by L_i)" } else { "" },
             scene.solver.alpha
         ),
@@ -132,7 +132,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
             "Eq. (8): r += Δt u"
         }
         .into(),
-        Stage::Diagnostics => "max speed, kinetic energy, density error, penetrations → stats.csv".into(),
+        Stage::Diagnostics => "max speed, kinetic energy, density error, disorder, penetrations → stats.csv".into(),
     }
 }
 

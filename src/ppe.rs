@@ -4,11 +4,10 @@
 //! * interior rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt², with the Laplacian of
 //!   Eq. (27) made first-order consistent where the free surface truncates the kernel. The wall
 //!   pairs of the Laplacian are known ghost differences and move to the right-hand side.
-//! * free-surface rows: the Robin condition P_i + δ n_i·∇P_i = 0 with δ = dx/2: P = 0 holds on
-//!   the surface itself, half a spacing beyond the centre of the outermost particle, where the
-//!   volume that particle stands for ends. (P_i = 0 at the particle would put the surface half a
-//!   spacing too low and the hydrostatic pressure ρ g dx/2 short everywhere below.) ∇P_i is the
-//!   corrected gradient of the corrector, so the boundary row and the force it produces agree.
+//! * free-surface rows: P_i = ρ0 |g| dx/2 (`surface_pressure`): P = 0 holds on the surface
+//!   itself, half a spacing beyond the centre of the outermost particle, where the volume that
+//!   particle stands for ends. (P_i = 0 at the particle would put the surface half a spacing
+//!   too low and the hydrostatic pressure ρ g dx/2 short everywhere below.)
 //! * splash rows (particles too isolated for a gradient): P_i = 0.
 //! * wall rows: P = 0, a placeholder; the walls' pressures for output are computed after the
 //!   solve from their fluid neighbours (`wall::wall_pressure`).
@@ -28,7 +27,7 @@ use wide::{f64x4, CmpNe};
 pub enum Role {
     /// Fluid with a full neighbourhood: the Laplacian row.
     Interior,
-    /// Fluid on the free surface: the Robin row.
+    /// Fluid on the free surface: P = ρ0 |g| dx/2, the water above its centre (`surface_pressure`).
     Surface,
     /// Fluid too isolated to have a pressure gradient (spray, drops): P = 0.
     Splash,
@@ -43,7 +42,7 @@ impl Role {
     }
 }
 
-/// Assigns roles: fluid on the free surface (see `free_surface`) takes the Robin row, or P = 0
+/// Assigns roles: fluid on the free surface (see `free_surface`) takes the surface row, or P = 0
 /// where it has no consistent gradient (`gradient_defined` false: the moment matrix of its
 /// pressure gradient is near-singular, whether or not the scene applies the kernel correction).
 /// If the fluid has no free surface at all (a full closed box) the PPE is singular; the highest
@@ -99,70 +98,37 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 
 /// The per-row vector of the operator, with L'_i the correction of the pressure gradient
 /// (`sph::Moments::m_neumann`): ĉ_i = L'_iᵀ c_i of the consistent Laplacian for interior rows
-/// (see `laplacian_correction`), q_i = δ L'_iᵀ n_i of the Robin condition for surface rows
-/// (δ n·∇P_i = δ n·L'_i Σ_j … = q_i·Σ_j …), zero otherwise. Deep inside the fluid c_i
-/// measures the disorder of the particles, and the row is corrected all the same: leaving those
-/// rows uncorrected let still water go unstable after about a second (max speed growing
-/// threefold every 0.17 s in `hydrostatic_2d`), with it the tank stays at rest. `corrected`
-/// marks the rows whose vector is not zero.
-#[allow(clippy::too_many_arguments)]
+/// (see `laplacian_correction`), zero otherwise. Deep inside the fluid c_i measures the
+/// disorder of the particles, and the row is corrected all the same: leaving those rows
+/// uncorrected let still water go unstable after about a second (max speed growing threefold
+/// every 0.17 s in `hydrostatic_2d`), with it the tank stays at rest. `corrected` marks the
+/// rows whose vector is not zero.
 pub fn row_vectors<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     roles: &[Role],
     pressure_corrections: Corrections<D>,
-    supports: &[Support<D>],
-    spacing: f64,
     out: &mut [Vec<f64>; D],
     corrected: &mut Vec<bool>,
 ) {
     fill_vector(out, |i| match roles[i] {
         Role::Interior => laplacian_correction(nb, p, pressure_corrections.of(i), i),
-        Role::Surface => {
-            let n = contact_line_normal(nb, p, supports[i].normal, spacing, i);
-            let delta = 0.5 * spacing;
-            match pressure_corrections.of(i) {
-                Some(l) => {
-                    std::array::from_fn(|a| delta * (0..D).map(|b| l[b][a] * n[b]).sum::<f64>())
-                }
-                None => n.map(|x| delta * x),
-            }
-        }
-        Role::Splash | Role::Wall => [0.0; D],
+        Role::Surface | Role::Splash | Role::Wall => [0.0; D],
     });
     corrected.resize(p.len(), false);
     fill(corrected, |i| (0..D).any(|d| out[d][i] != 0.0));
 }
 
-/// The free-surface normal for the Robin row of surface particle i. Where the surface meets a
-/// wall (a wall particle within 1.5 dx, the contact line), the free surface meets the wall at a
-/// right angle (no surface tension, no wetting), so the normal is taken along the wall: the
-/// part of −∇C_i across the wall comes from dry wall above the water standing in for fluid, and
-/// would tilt the normal off the wall and lower the boundary pressure there.
-fn contact_line_normal<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    normal: [f64; D],
-    spacing: f64,
-    i: usize,
-) -> [f64; D] {
-    let mut nearest = (1.5 * spacing, None);
-    nb.for_each(i, |j, _, r| {
-        if !p.is_fluid(j) && r < nearest.0 {
-            nearest = (r, Some(j));
-        }
-    });
-    let Some(b) = nearest.1 else {
-        return normal;
-    };
-    let across = behind_walls(p, b, normal);
-    let along: [f64; D] = std::array::from_fn(|d| normal[d] - across[d]);
-    let len = along.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if len > 0.1 {
-        along.map(|x| x / len)
-    } else {
-        normal
-    }
+/// Pressure of a free-surface particle: the surface itself lies about δ = dx/2 beyond the
+/// particle's centre, so P = 0 there puts P_i = ρ0 |g| δ, the weight of the water above the
+/// centre (exact in still water; where the true P_i is 0, as in a free-falling jet, it errs by
+/// ρ0 |g| dx/2 at most). Two ways of following the surface's orientation were measured and
+/// dropped on `hydrostatic_2d` run for 20 s: ρ0 δ (−g·n)⁺ with n the surface normal, and the
+/// Robin row P_i + δ n·∇P_i = 0; both let the surface layer oscillate with a slowly growing
+/// amplitude (max speed 0.01 and 0.5 m/s after 20 s), this constant keeps the tank at rest
+/// (below 1e-4 m/s).
+fn surface_pressure(rest_density: f64, gravity: f64, spacing: f64) -> f64 {
+    rest_density * gravity * 0.5 * spacing
 }
 
 /// Right-hand side b of the PPE rows (same sign convention as `PressureOperator`).
@@ -170,6 +136,7 @@ fn contact_line_normal<const D: usize>(
 pub fn source<const D: usize>(
     op: &PressureOperator<D>,
     full: &[bool],
+    spacing: f64,
     corrections: Corrections<D>,
     u_star: &[Vec<f64>; D],
     dt: f64,
@@ -177,6 +144,7 @@ pub fn source<const D: usize>(
     b: &mut Vec<f64>,
 ) {
     let (nb, p) = (op.nb, op.p);
+    let g = op.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     b.resize(p.len(), 0.0);
     fill(b, |i| {
         let walls = op.wall_source(i);
@@ -184,7 +152,8 @@ pub fn source<const D: usize>(
             Role::Interior => {
                 divergence_source(nb, p, corrections.of(i), u_star, full[i], dt, alpha, i) + walls
             }
-            Role::Surface | Role::Splash | Role::Wall => walls,
+            Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
+            Role::Splash | Role::Wall => walls,
         }
     });
 }
@@ -297,14 +266,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         (laplacian - correction).max(f64x4::ZERO) & l.mask
     }
 
-    /// Weights of (P_j − P_i) in the Robin row i: V_j q_i·∇W_ij (see `interior_weights`).
-    #[inline(always)]
-    fn surface_weights(&self, i: usize, l: &Lanes<D>, volume: f64x4) -> f64x4 {
-        let f = self.nb.kernel.grad_factor4(l.r);
-        (volume * f * self.row_vector_dot(i, l)) & l.mask
-    }
-
-    /// ĉ_i·r_ij (interior) or q_i·r_ij (surface) per lane.
+    /// ĉ_i·r_ij per lane.
     #[inline(always)]
     fn row_vector_dot(&self, i: usize, l: &Lanes<D>) -> f64x4 {
         (0..D).fold(f64x4::ZERO, |s, d| {
@@ -336,10 +298,7 @@ impl<const D: usize> PressureOperator<'_, D> {
             Role::Interior => self.nb.for_each_lanes(i, |l| {
                 b += self.interior_weights(i, l, self.wall_volumes(l)) * self.ghosts(i, l);
             }),
-            Role::Surface => self.nb.for_each_lanes(i, |l| {
-                b -= self.surface_weights(i, l, self.wall_volumes(l)) * self.ghosts(i, l);
-            }),
-            Role::Splash | Role::Wall => {}
+            Role::Surface | Role::Splash | Role::Wall => {}
         }
         b.reduce_add()
     }
@@ -347,23 +306,17 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// (A x)_i.
     #[inline]
     fn row(&self, x: &[f64], i: usize) -> f64 {
-        let nb = self.nb;
-        let xi = f64x4::splat(x[i]);
-        let mut ax = f64x4::ZERO;
         match self.roles[i] {
-            Role::Interior => nb.for_each_lanes(i, |l| {
-                let w = self.interior_weights(i, l, l.load(self.fluid_volume));
-                ax = w.mul_add(xi - l.load(x), ax);
-            }),
-            Role::Surface => nb.for_each_lanes(i, |l| {
-                let w = self.surface_weights(i, l, l.load(self.fluid_volume));
-                ax = w.mul_add(l.load(x) - xi, ax);
-            }),
-            Role::Splash | Role::Wall => {}
-        }
-        match self.roles[i] {
-            Role::Interior => ax.reduce_add(),
-            Role::Surface | Role::Splash | Role::Wall => x[i] + ax.reduce_add(),
+            Role::Interior => {
+                let xi = f64x4::splat(x[i]);
+                let mut ax = f64x4::ZERO;
+                self.nb.for_each_lanes(i, |l| {
+                    let w = self.interior_weights(i, l, l.load(self.fluid_volume));
+                    ax = w.mul_add(xi - l.load(x), ax);
+                });
+                ax.reduce_add()
+            }
+            Role::Surface | Role::Splash | Role::Wall => x[i],
         }
     }
 }
@@ -394,13 +347,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
                         1.0
                     }
                 }
-                Role::Surface => {
-                    nb.for_each_lanes(i, |l| {
-                        d += self.surface_weights(i, l, l.load(self.fluid_volume))
-                    });
-                    1.0 - d.reduce_add()
-                }
-                Role::Splash | Role::Wall => 1.0,
+                Role::Surface | Role::Splash | Role::Wall => 1.0,
             }
         })
     }
@@ -413,8 +360,8 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
 
     fn aggregate(&self, i: usize) -> Option<usize> {
         match self.roles[i] {
-            Role::Interior | Role::Surface => Some(self.nb.grid().cell_of_sorted(i)),
-            Role::Splash | Role::Wall => None,
+            Role::Interior => Some(self.nb.grid().cell_of_sorted(i)),
+            Role::Surface | Role::Splash | Role::Wall => None,
         }
     }
 
@@ -422,30 +369,21 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
         let grid = self.nb.grid();
         let (dims, cell) = (grid.dims(), grid.cell_of_sorted(i));
         let centre = stencil_slot([0; D]);
-        // Interior rows: a_ii = Σ w, a_ij = −w; Robin rows: a_ii = 1 − Σ w, a_ij = w.
-        let sign = match self.roles[i] {
-            Role::Interior => -1.0,
-            Role::Surface => {
-                row[centre] += 1.0;
-                1.0
-            }
-            Role::Splash | Role::Wall => return,
-        };
+        // Interior rows: a_ii = Σ w, a_ij = −w; the other rows are not aggregated.
+        if self.roles[i] != Role::Interior {
+            return;
+        }
         self.nb.for_each_lanes(i, |l| {
-            let w = match self.roles[i] {
-                Role::Interior => self.interior_weights(i, l, l.load(self.fluid_volume)),
-                _ => self.surface_weights(i, l, l.load(self.fluid_volume)),
-            }
-            .to_array();
-            for (k, w) in w.into_iter().enumerate() {
+            let w = self.interior_weights(i, l, l.load(self.fluid_volume));
+            for (k, w) in w.to_array().into_iter().enumerate() {
                 if w == 0.0 {
                     continue;
                 }
-                row[centre] -= sign * w;
+                row[centre] += w;
                 let j = l.j0 + k;
                 if self.aggregate(j).is_some() {
                     let slot = stencil_slot(cell_offset(dims, cell, grid.cell_of_sorted(j)));
-                    row[slot] += sign * w;
+                    row[slot] -= w;
                 }
             }
         });

@@ -153,7 +153,10 @@ impl<const D: usize> Workspace<D> {
             let mut clock = Instant::now();
             let mut lap = |stage: Stage| {
                 let now = Instant::now();
-                timings.add(stage, now - clock);
+                match stage {
+                    Stage::Diagnostics => timings.add_part(stage, now - clock),
+                    _ => timings.add(stage, now - clock),
+                }
                 clock = now;
             };
             self.summation_density(&nb, p);
@@ -416,8 +419,6 @@ impl<const D: usize> Workspace<D> {
             p,
             &self.roles,
             Corrections::new(kernel_correction, &self.pressure_corrections),
-            &self.supports,
-            set.spacing,
             &mut self.row_vectors,
             &mut self.corrected,
         );
@@ -440,6 +441,7 @@ impl<const D: usize> Workspace<D> {
         ppe::source(
             &op,
             &self.full_support,
+            set.spacing,
             Corrections::new(kernel_correction, &self.corrections),
             &self.u_star,
             dt,

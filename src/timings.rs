@@ -77,6 +77,12 @@ impl Timings {
         self.runs[stage as usize] += 1;
     }
 
+    /// Adds `d` to `stage` without counting a run: the part of a stage done elsewhere in the
+    /// same step (the diagnostics' pair loop inside the step, their sums after it).
+    pub fn add_part(&mut self, stage: Stage, d: Duration) {
+        self.spent[stage as usize] += d;
+    }
+
     pub fn get(&self, stage: Stage) -> Duration {
         self.spent[stage as usize]
     }
