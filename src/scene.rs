@@ -100,7 +100,7 @@ impl Default for SolverSettings {
         Self {
             tolerance: 1.0e-6,
             max_iterations: 1000,
-            alpha: 0.01,
+            alpha: 0.1,
             cfl: 0.2,
             h_over_dx: 1.2,
         }

@@ -15,3 +15,4 @@ mod linsolve;
 mod neighbours;
 mod operators;
 mod output_readers;
+mod stability;
