@@ -139,3 +139,57 @@ pub fn wall_normal<const D: usize>(container: &Aabb, obstacles: &[Aabb], x: [f64
     }
     best.1
 }
+
+/// Hard contact with the walls' faces, the last line of the wall condition: a fluid particle
+/// whose step ended within `gap` of a face of the container or inside an obstacle (a fast
+/// particle at a large CFL number can cross the half spacing between the fluid and a face in
+/// one step, where the ghost pressure has had no time to stop it) is put back `gap` inside the
+/// fluid's side of that face, and its velocity loses the part into the face (an inelastic
+/// contact, as `no_penetration`). Returns whether the particle was moved.
+pub fn face_contact<const D: usize>(
+    container: &Aabb,
+    obstacles: &[Aabb],
+    gap: f64,
+    x: &mut [f64; D],
+    u: &mut [f64; D],
+) -> bool {
+    let mut moved = false;
+    for d in 0..D {
+        let (lo, hi) = (container.min[d] + gap, container.max[d] - gap);
+        if x[d] < lo {
+            (x[d], u[d], moved) = (lo, u[d].max(0.0), true);
+        } else if x[d] > hi {
+            (x[d], u[d], moved) = (hi, u[d].min(0.0), true);
+        }
+    }
+    for o in obstacles {
+        if !o.contains(x.as_slice()) {
+            continue;
+        }
+        // Out through the nearest face.
+        let (mut depth, mut exit) = (f64::INFINITY, (0, 0.0, 0.0));
+        for d in 0..D {
+            for (inside, sign) in [(x[d] - o.min[d], -1.0), (o.max[d] - x[d], 1.0)] {
+                if inside < depth {
+                    depth = inside;
+                    exit = (
+                        d,
+                        sign,
+                        if sign < 0.0 {
+                            o.min[d] - gap
+                        } else {
+                            o.max[d] + gap
+                        },
+                    );
+                }
+            }
+        }
+        let (d, sign, face) = exit;
+        x[d] = face;
+        if u[d] * sign < 0.0 {
+            u[d] = 0.0;
+        }
+        moved = true;
+    }
+    moved
+}

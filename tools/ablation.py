@@ -123,7 +123,8 @@ def hydrostatic_noise(out: Path, scene: dict) -> float:
         frame = f[sorted(f, key=lambda k: f[k].attrs["time"])[-1]]
         kind, pos, p = frame["kind"][:], frame["position"][:], frame["pressure"][:]
     fluid = kind == 0
-    y = pos[fluid, -1]
+    up = len(scene["simulation"]["gravity"]) - 1  # positions are stored with 3 components
+    y = pos[fluid, up]
     spacing = scene["simulation"]["spacing"]
     surface = y.max() + 0.5 * spacing
     depth = surface - y
