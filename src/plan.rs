@@ -126,12 +126,10 @@ fn describe(stage: Stage, scene: &Scene) -> String {
                 s.coefficient, s.clustering_weight, s.max_shift
             )
         }
-        Stage::Advection => if effects.shifting.is_some() {
-            "Eq. (8): r += Δt u + δr"
-        } else {
-            "Eq. (8): r += Δt u"
-        }
-        .into(),
+        Stage::Advection => format!(
+            "Eq. (8): r += Δt u{}; a particle that crossed a wall face is put back a quarter spacing inside (counted in penetrations)",
+            if effects.shifting.is_some() { " + δr" } else { "" }
+        ),
         Stage::Diagnostics => "max speed, kinetic energy, density error, disorder, penetrations → stats.csv".into(),
     }
 }

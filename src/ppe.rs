@@ -280,7 +280,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         let p = self.p;
         let g_r = (0..D).fold(f64x4::ZERO, |s, d| {
             let across = l.load(&p.normal[d]).cmp_ne(f64x4::ZERO);
-            (f64x4::splat(self.gravity[d]) * l.rij[d] & across) + s
+            ((f64x4::splat(self.gravity[d]) * l.rij[d]) & across) + s
         });
         f64x4::splat(-p.rest_density[i]) * g_r
     }

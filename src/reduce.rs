@@ -21,7 +21,7 @@ pub fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
 pub fn max(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
     (0..n)
         .into_par_iter()
-        .map(|i| f(i))
+        .map(&f)
         .reduce(|| 0.0, f64::max)
 }
 
