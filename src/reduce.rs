@@ -19,10 +19,7 @@ pub fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
 
 /// max_i f(i) for i in 0..n (0 when n = 0). A maximum does not depend on the order.
 pub fn max(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
-    (0..n)
-        .into_par_iter()
-        .map(&f)
-        .reduce(|| 0.0, f64::max)
+    (0..n).into_par_iter().map(&f).reduce(|| 0.0, f64::max)
 }
 
 /// Number of i in 0..n with `pred(i)`.
