@@ -16,3 +16,4 @@ mod neighbours;
 mod operators;
 mod output_readers;
 mod stability;
+mod wall_contact;
