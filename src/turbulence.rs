@@ -17,6 +17,7 @@
 
 use crate::particles::Particles;
 use crate::sph::{fluid_velocity, velocity_gradient, Correction, Neighbours};
+use crate::wall;
 
 /// The constants of the turbulence model (the scene's `[effects.les]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,13 +76,7 @@ pub fn wall_shear<const D: usize>(
     spacing: f64,
     i: usize,
 ) -> [f64; D] {
-    let mut nearest = (1.5 * spacing, None);
-    nb.for_each(i, |j, rij, r| {
-        if !p.is_fluid(j) && r < nearest.0 {
-            nearest = (r, Some((j, rij)));
-        }
-    });
-    let Some((b, r_ib)) = nearest.1 else {
+    let Some((b, r_ib)) = wall::nearest_wall(nb, p, 1.5 * spacing, i) else {
         return [0.0; D];
     };
     let n = p.wall_normal(b);

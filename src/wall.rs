@@ -86,6 +86,22 @@ pub fn wall_pressure<const D: usize>(
     }
 }
 
+/// The wall particle b nearest to particle i closer than `within`, with r_ib, if any.
+pub fn nearest_wall<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    within: f64,
+    i: usize,
+) -> Option<(usize, [f64; D])> {
+    let mut nearest = (within, None);
+    nb.for_each(i, |j, rij, r| {
+        if !p.is_fluid(j) && r < nearest.0 {
+            nearest = (r, Some((j, rij)));
+        }
+    });
+    nearest.1
+}
+
 /// The wall a fluid particle touches: the normal of the nearest wall particle closer than the
 /// spacing dx (nearer than at rest), or zero where there is none.
 pub fn contact_normal<const D: usize>(
@@ -94,13 +110,7 @@ pub fn contact_normal<const D: usize>(
     spacing: f64,
     i: usize,
 ) -> [f64; D] {
-    let mut nearest = (spacing, None);
-    nb.for_each(i, |j, _, r| {
-        if !p.is_fluid(j) && r < nearest.0 {
-            nearest = (r, Some(j));
-        }
-    });
-    nearest.1.map_or([0.0; D], |b| p.wall_normal(b))
+    nearest_wall(nb, p, spacing, i).map_or([0.0; D], |(b, _)| p.wall_normal(b))
 }
 
 /// The kinematic wall condition v·n ≥ 0 for a velocity or displacement v of a fluid particle
