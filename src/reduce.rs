@@ -10,11 +10,23 @@ pub const CHUNK: usize = 2048;
 
 /// Σ_i f(i) for i in 0..n, summed in fixed chunks (deterministic for any thread count).
 pub fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
-    let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
+    sums(n, |i| [f(i)])[0]
+}
+
+/// Σ_i f(i) of K quantities at once, in one pass over i in 0..n, summed like `sum` in fixed
+/// chunks (each component from −0.0, as `Iterator::sum` of f64 starts).
+pub fn sums<const K: usize>(n: usize, f: impl Fn(usize) -> [f64; K] + Sync) -> [f64; K] {
+    let add = |mut a: [f64; K], b: [f64; K]| {
+        for k in 0..K {
+            a[k] += b[k];
+        }
+        a
+    };
+    let partial: Vec<[f64; K]> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).sum::<f64>())
+        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).fold([-0.0; K], add))
         .collect();
-    partial.iter().sum()
+    partial.into_iter().fold([-0.0; K], add)
 }
 
 /// max_i f(i) for i in 0..n (0 when n = 0). A maximum does not depend on the order.

@@ -180,9 +180,8 @@ impl<const D: usize> Workspace<D> {
             lap(Stage::PressureSolve);
             self.correct(&nb, p, set, dt);
             std::mem::swap(&mut p.vel, &mut self.velocity);
-            let density_error = self.density_error(p);
             lap(Stage::Corrector);
-            let disorder = self.disorder(&nb, p);
+            let (density_error, disorder) = self.full_support_statistics(&nb, p);
             lap(Stage::Diagnostics);
             self.wall_pressure(&nb, p, set.gravity);
             std::mem::swap(&mut p.pressure, &mut self.pressure);
@@ -486,48 +485,30 @@ impl<const D: usize> Workspace<D> {
         });
     }
 
-    /// Mean |ρ/ρ0 − 1| where the summation density is not truncated by the free surface.
-    fn density_error(&self, p: &Particles<D>) -> f64 {
+    /// Two measures over the fluid particles with no free surface in reach (where the
+    /// summation density is not truncated), in one pass:
+    /// - the density error, mean |ρ/ρ0 − 1|;
+    /// - the particle disorder, the coefficient of variation (standard deviation over mean) of
+    ///   the distance from each particle to its nearest neighbour: zero on a lattice, a few per
+    ///   cent when particles stay well spread, growing as they cluster into lines and gaps
+    ///   (tensile instability, no shifting).
+    fn full_support_statistics(&self, nb: &Neighbours<D>, p: &Particles<D>) -> (f64, f64) {
         let full = &self.full_support;
-        let n_full = full.iter().filter(|&&f| f).count();
-        if n_full == 0 {
-            return 0.0;
-        }
-        let sum = reduce::sum(p.len(), |i| {
-            if full[i] {
-                (p.density[i] / p.rest_density[i] - 1.0).abs()
-            } else {
-                0.0
+        let [count, density, distance, square] = reduce::sums(p.len(), |i| {
+            if !full[i] {
+                return [0.0; 4];
             }
+            let mut nearest = f64::INFINITY;
+            nb.for_each(i, |_, _, r| nearest = nearest.min(r));
+            let error = (p.density[i] / p.rest_density[i] - 1.0).abs();
+            [1.0, error, nearest, nearest * nearest]
         });
-        sum / n_full as f64
-    }
-
-    /// Particle disorder: the coefficient of variation (standard deviation over mean) of the
-    /// distance from each particle to its nearest neighbour, over the fluid particles with no
-    /// free surface in reach. Zero on a lattice; a few per cent when particles stay well spread,
-    /// growing as they cluster into lines and gaps (tensile instability, no shifting).
-    fn disorder(&self, nb: &Neighbours<D>, p: &Particles<D>) -> f64 {
-        let full = &self.full_support;
-        let n_full = full.iter().filter(|&&f| f).count();
-        if n_full == 0 {
-            return 0.0;
+        if count == 0.0 {
+            return (0.0, 0.0);
         }
-        let nearest = |i: usize| {
-            let mut d = f64::INFINITY;
-            nb.for_each(i, |_, _, r| d = d.min(r));
-            d
-        };
-        let sum = reduce::sum(p.len(), |i| if full[i] { nearest(i) } else { 0.0 });
-        let mean = sum / n_full as f64;
-        let square = reduce::sum(p.len(), |i| {
-            if full[i] {
-                (nearest(i) - mean).powi(2)
-            } else {
-                0.0
-            }
-        });
-        (square / n_full as f64).sqrt() / mean
+        let mean = distance / count;
+        let variance = (square / count - mean * mean).max(0.0);
+        (density / count, variance.sqrt() / mean)
     }
 
     /// The pressures of the wall particles, for output and wall loads: the ghost pressures
