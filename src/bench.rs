@@ -11,7 +11,7 @@
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::linsolve::LinearOperator;
-use crate::particles::{Kind, Particles};
+use crate::particles::Particles;
 use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::fill;
 use crate::scene::{Scene, SceneError};
@@ -170,8 +170,8 @@ pub struct Measurement {
     pub ppe_iterations: Vec<usize>,
     /// `density_error` of the last timed step.
     pub density_error: f64,
-    /// Neighbour pairs (j ≠ i inside the kernel support) of the PPE rows that hold an unknown:
-    /// the pair interactions of one apply.
+    /// Neighbour pairs (j ≠ i inside the kernel support) of the interior PPE rows: the pair
+    /// interactions of one apply.
     pub apply_pairs: usize,
     /// Wall time of each timed apply of the PPE operator [s].
     pub apply_seconds: Vec<f64>,
@@ -273,8 +273,8 @@ fn time_ppe_apply<const D: usize>(
 /// The PPE operator of the step (`ppe::PressureOperator`), rebuilt from a particle state
 /// through the public API, to time its apply on its own.
 ///
-/// The roles come from `Particles::free_surface`, the step's record of them (0 interior or
-/// wall, 1 free surface, 2 splash). Every interior row carries the consistency correction, as
+/// The roles come from `Particles::free_surface`, the step's record of them (`Role::code`).
+/// Every interior row carries the consistency correction, as
 /// in the step, with the uncorrected c_i (the kernel correction's matrices are not rebuilt):
 /// each pair costs the arithmetic it costs in the step.
 pub struct PpeSetup<const D: usize> {
@@ -282,7 +282,6 @@ pub struct PpeSetup<const D: usize> {
     pub roles: Vec<Role>,
     pub row_vectors: [Vec<f64>; D],
     pub fluid_volume: Vec<f64>,
-    pub corrected: Vec<bool>,
 }
 
 impl<const D: usize> PpeSetup<D> {
@@ -300,14 +299,10 @@ impl<const D: usize> PpeSetup<D> {
             .expect("the grid spans the particles' bounding box");
         p.permute(&order, &mut scratch);
         let mut roles = vec![Role::Wall; p.len()];
-        fill(&mut roles, |i| match (p.kind[i], p.free_surface[i]) {
-            (Kind::Wall, _) => Role::Wall,
-            (Kind::Fluid, 1) => Role::Surface,
-            (Kind::Fluid, 2) => Role::Splash,
-            (Kind::Fluid, _) => Role::Interior,
+        fill(&mut roles, |i| {
+            Role::from_code(p.kind[i], p.free_surface[i])
         });
         let mut row_vectors = std::array::from_fn(|_| vec![0.0; p.len()]);
-        let mut corrected = Vec::new();
         let nb = Neighbours::new(&grid, &p.pos, kernel);
         ppe::row_vectors(
             &nb,
@@ -315,22 +310,14 @@ impl<const D: usize> PpeSetup<D> {
             &roles,
             Corrections::new(false, &[]),
             &mut row_vectors,
-            &mut corrected,
         );
-        let mut fluid_volume = vec![0.0; p.len()];
-        fill(&mut fluid_volume, |i| {
-            if p.is_fluid(i) {
-                p.mass[i] / p.rest_density[i]
-            } else {
-                0.0
-            }
-        });
+        let mut fluid_volume = Vec::new();
+        ppe::fluid_volumes(p, &mut fluid_volume);
         Self {
             grid,
             roles,
             row_vectors,
             fluid_volume,
-            corrected,
         }
     }
 
@@ -350,17 +337,16 @@ impl<const D: usize> PpeSetup<D> {
             roles: &self.roles,
             row_vectors: &self.row_vectors,
             fluid_volume: &self.fluid_volume,
-            corrected: &self.corrected,
             gravity,
         }
     }
 
-    /// Neighbour pairs of the rows that hold an unknown (interior and free-surface rows): the
-    /// pair interactions of one apply.
+    /// Neighbour pairs of the interior rows, the only rows that visit their neighbours (the
+    /// others are identity rows): the pair interactions of one apply.
     pub fn pairs(&self, nb: &Neighbours<D>) -> usize {
         (0..self.roles.len())
             .into_par_iter()
-            .filter(|&i| matches!(self.roles[i], Role::Interior | Role::Surface))
+            .filter(|&i| self.roles[i] == Role::Interior)
             .map(|i| {
                 let mut n = 0;
                 nb.for_each(i, |_, _, _| n += 1);

@@ -40,6 +40,38 @@ impl Role {
     pub fn is_free(self) -> bool {
         matches!(self, Role::Surface | Role::Splash)
     }
+
+    /// The role's code in the frames' `free_surface` dataset (`Particles::free_surface`):
+    /// 1 free surface, 2 splash, 0 interior or wall.
+    pub fn code(self) -> u8 {
+        match self {
+            Role::Surface => 1,
+            Role::Splash => 2,
+            Role::Interior | Role::Wall => 0,
+        }
+    }
+
+    /// The role of a particle of `kind` whose `free_surface` code is `code` (see `code`).
+    pub fn from_code(kind: Kind, code: u8) -> Role {
+        match (kind, code) {
+            (Kind::Wall, _) => Role::Wall,
+            (Kind::Fluid, 1) => Role::Surface,
+            (Kind::Fluid, 2) => Role::Splash,
+            (Kind::Fluid, _) => Role::Interior,
+        }
+    }
+}
+
+/// V_i = m_i/ρ0_i of fluid particles, zero for walls: the volumes the PPE rows couple.
+pub fn fluid_volumes<const D: usize>(p: &Particles<D>, out: &mut Vec<f64>) {
+    out.resize(p.len(), 0.0);
+    fill(out, |i| {
+        if p.is_fluid(i) {
+            p.mass[i] / p.rest_density[i]
+        } else {
+            0.0
+        }
+    });
 }
 
 /// Assigns roles: fluid on the free surface (see `free_surface`) takes the surface row, or P = 0
@@ -101,22 +133,18 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 /// (see `laplacian_correction`), zero otherwise. Deep inside the fluid c_i measures the
 /// disorder of the particles, and the row is corrected all the same: leaving those rows
 /// uncorrected let still water go unstable after about a second (max speed growing threefold
-/// every 0.17 s in `hydrostatic_2d`), with it the tank stays at rest. `corrected` marks the
-/// rows whose vector is not zero.
+/// every 0.17 s in `hydrostatic_2d`), with it the tank stays at rest.
 pub fn row_vectors<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     roles: &[Role],
     pressure_corrections: Corrections<D>,
     out: &mut [Vec<f64>; D],
-    corrected: &mut Vec<bool>,
 ) {
     fill_vector(out, |i| match roles[i] {
         Role::Interior => laplacian_correction(nb, p, pressure_corrections.of(i), i),
         Role::Surface | Role::Splash | Role::Wall => [0.0; D],
     });
-    corrected.resize(p.len(), false);
-    fill(corrected, |i| (0..D).any(|d| out[d][i] != 0.0));
 }
 
 /// Pressure of a free-surface particle: the surface itself lies about δ = dx/2 beyond the
@@ -146,15 +174,13 @@ pub fn source<const D: usize>(
     let (nb, p) = (op.nb, op.p);
     let g = op.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     b.resize(p.len(), 0.0);
-    fill(b, |i| {
-        let walls = op.wall_source(i);
-        match op.roles[i] {
-            Role::Interior => {
-                divergence_source(nb, p, corrections.of(i), u_star, full[i], dt, alpha, i) + walls
-            }
-            Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
-            Role::Splash | Role::Wall => walls,
+    fill(b, |i| match op.roles[i] {
+        Role::Interior => {
+            divergence_source(nb, p, corrections.of(i), u_star, full[i], dt, alpha, i)
+                + op.wall_source(i)
         }
+        Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
+        Role::Splash | Role::Wall => 0.0,
     });
 }
 
@@ -239,10 +265,9 @@ pub struct PressureOperator<'a, const D: usize> {
     pub roles: &'a [Role],
     /// The row vectors of `row_vectors`.
     pub row_vectors: &'a [Vec<f64>; D],
-    /// V_j = m_j/ρ0_j of fluid particles, zero for walls: the unknowns the rows couple.
+    /// V_j = m_j/ρ0_j of fluid particles, zero for walls: the unknowns the rows couple
+    /// (`fluid_volumes`).
     pub fluid_volume: &'a [f64],
-    /// Whether row i carries the consistency correction (its row vector is not zero).
-    pub corrected: &'a [bool],
     pub gravity: [f64; D],
 }
 
@@ -256,9 +281,6 @@ impl<const D: usize> PressureOperator<'_, D> {
         let (f, laplacian_factor) = nb.gradient_and_laplacian_factors4(l.r);
         let mass = volume * l.load(&p.rest_density);
         let laplacian = f64x4::splat(-2.0 / p.rest_density[i]) * mass * laplacian_factor;
-        if !self.corrected[i] {
-            return laplacian & l.mask;
-        }
         let correction = volume * f * self.row_vector_dot(i, l);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
@@ -291,15 +313,13 @@ impl<const D: usize> PressureOperator<'_, D> {
         l.load(&self.p.mass) / l.load(&self.p.rest_density) - l.load(self.fluid_volume)
     }
 
-    /// The wall part of the right-hand side of row i: the Neumann ghosts' known differences.
+    /// The wall part of the right-hand side of interior row i: the Neumann ghosts' known
+    /// differences.
     fn wall_source(&self, i: usize) -> f64 {
         let mut b = f64x4::ZERO;
-        match self.roles[i] {
-            Role::Interior => self.nb.for_each_lanes(i, |l| {
-                b += self.interior_weights(i, l, self.wall_volumes(l)) * self.ghosts(i, l);
-            }),
-            Role::Surface | Role::Splash | Role::Wall => {}
-        }
+        self.nb.for_each_lanes(i, |l| {
+            b += self.interior_weights(i, l, self.wall_volumes(l)) * self.ghosts(i, l);
+        });
         b.reduce_add()
     }
 

@@ -24,7 +24,11 @@ pub fn sums<const K: usize>(n: usize, f: impl Fn(usize) -> [f64; K] + Sync) -> [
     };
     let partial: Vec<[f64; K]> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).fold([-0.0; K], add))
+        .map(|c| {
+            (c * CHUNK..((c + 1) * CHUNK).min(n))
+                .map(&f)
+                .fold([-0.0; K], add)
+        })
         .collect();
     partial.into_iter().fold([-0.0; K], add)
 }

@@ -93,8 +93,6 @@ pub struct Workspace<const D: usize> {
     u_star: [Vec<f64>; D],
     /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
     row_vectors: [Vec<f64>; D],
-    /// Rows with a non-zero row vector.
-    corrected: Vec<bool>,
     /// V_j = m_j/ρ0_j of fluid particles, zero for walls (the unknowns of the PPE).
     fluid_volume: Vec<f64>,
     rhs: Vec<f64>,
@@ -122,7 +120,6 @@ impl<const D: usize> Default for Workspace<D> {
             eddy: Vec::new(),
             u_star: components(),
             row_vectors: components(),
-            corrected: Vec::new(),
             fluid_volume: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
@@ -219,7 +216,6 @@ impl<const D: usize> Workspace<D> {
             eddy,
             u_star,
             row_vectors,
-            corrected,
             fluid_volume,
             rhs,
             pressure,
@@ -255,10 +251,6 @@ impl<const D: usize> Workspace<D> {
             (
                 Stage::PressureSolve,
                 ArraySize::of_components("row vector", row_vectors),
-            ),
-            (
-                Stage::PressureSolve,
-                ArraySize::of("corrected row", corrected),
             ),
             (
                 Stage::PressureSolve,
@@ -331,11 +323,7 @@ impl<const D: usize> Workspace<D> {
             &mut self.roles,
         );
         ppe::full_support(nb, &self.roles, &mut self.full_support);
-        fill(&mut self.free_surface, |i| match self.roles[i] {
-            Role::Surface => 1,
-            Role::Splash => 2,
-            Role::Interior | Role::Wall => 0,
-        });
+        fill(&mut self.free_surface, |i| self.roles[i].code());
     }
 
     /// Inside the fluid (no free surface in reach) the moment matrix measures the disorder of
@@ -410,7 +398,6 @@ impl<const D: usize> Workspace<D> {
         for a in &mut self.row_vectors {
             a.resize(n, 0.0);
         }
-        self.fluid_volume.resize(n, 0.0);
         self.pressure.resize(n, 0.0);
         let kernel_correction = set.effects.kernel_correction;
         ppe::row_vectors(
@@ -419,22 +406,14 @@ impl<const D: usize> Workspace<D> {
             &self.roles,
             Corrections::new(kernel_correction, &self.pressure_corrections),
             &mut self.row_vectors,
-            &mut self.corrected,
         );
-        fill(&mut self.fluid_volume, |i| {
-            if p.is_fluid(i) {
-                p.mass[i] / p.rest_density[i]
-            } else {
-                0.0
-            }
-        });
+        ppe::fluid_volumes(p, &mut self.fluid_volume);
         let op = PressureOperator {
             nb,
             p,
             roles: &self.roles,
             row_vectors: &self.row_vectors,
             fluid_volume: &self.fluid_volume,
-            corrected: &self.corrected,
             gravity: set.gravity,
         };
         ppe::source(
