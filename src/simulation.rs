@@ -11,7 +11,7 @@ use crate::reduce;
 use crate::scene::{Aabb, Scene};
 use crate::step::{speed, StepReport, StepSettings, Workspace};
 use crate::timings::{Stage, Timings};
-use crate::wall;
+use crate::wall::{self, Contact};
 use std::time::Instant;
 
 /// Viscous time-step limit Δt ≤ C_ν h²/ν.
@@ -281,35 +281,24 @@ impl<const D: usize> Simulation<D> {
     /// not stop. Timed as part of the advection.
     fn keep_off_the_faces(&mut self) -> usize {
         let clock = Instant::now();
-        let penetrations = self.penetrations();
         let gap = 0.25 * self.settings.spacing;
         let p = &mut self.particles;
+        let mut penetrations = 0;
         for i in 0..p.len() {
             if !p.is_fluid(i) {
                 continue;
             }
             let (mut x, mut u) = (p.position(i), p.velocity(i));
-            if wall::face_contact(&self.container, &self.obstacles, gap, &mut x, &mut u) {
-                for d in 0..D {
-                    (p.pos[d][i], p.vel[d][i]) = (x[d], u[d]);
-                }
+            match wall::face_contact(&self.container, &self.obstacles, gap, &mut x, &mut u) {
+                Contact::Clear => continue,
+                Contact::Near => {}
+                Contact::Crossed => penetrations += 1,
+            }
+            for d in 0..D {
+                (p.pos[d][i], p.vel[d][i]) = (x[d], u[d]);
             }
         }
         self.timings.add_part(Stage::Advection, clock.elapsed());
         penetrations
-    }
-
-    /// Fluid particles whose centre lies inside a wall: outside the container or in an obstacle.
-    pub fn penetrations(&self) -> usize {
-        let p = &self.particles;
-        reduce::count(p.len(), |i| {
-            if !p.is_fluid(i) {
-                return false;
-            }
-            let x = p.position(i);
-            let c = &self.container;
-            let outside = (0..D).any(|d| x[d] < c.min[d] || x[d] > c.max[d]);
-            outside || self.obstacles.iter().any(|o| o.contains(&x))
-        })
     }
 }

@@ -150,56 +150,67 @@ pub fn wall_normal<const D: usize>(container: &Aabb, obstacles: &[Aabb], x: [f64
     best.1
 }
 
+/// What `face_contact` did to a particle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Contact {
+    /// Nothing: the particle is more than `gap` inside the container and outside every obstacle.
+    Clear,
+    /// Put back `gap` off a face it had come closer to than `gap`, without crossing it.
+    Near,
+    /// Put back from beyond a face: its centre was outside the container or inside an
+    /// obstacle (a penetration).
+    Crossed,
+}
+
 /// Hard contact with the walls' faces, the last line of the wall condition: a fluid particle
 /// whose step ended within `gap` of a face of the container or inside an obstacle (a fast
 /// particle at a large CFL number can cross the half spacing between the fluid and a face in
 /// one step, where the ghost pressure has had no time to stop it) is put back `gap` inside the
 /// fluid's side of that face, and its velocity loses the part into the face (an inelastic
-/// contact, as `no_penetration`). Returns whether the particle was moved.
+/// contact, as `no_penetration`).
 pub fn face_contact<const D: usize>(
     container: &Aabb,
     obstacles: &[Aabb],
     gap: f64,
     x: &mut [f64; D],
     u: &mut [f64; D],
-) -> bool {
-    let mut moved = false;
+) -> Contact {
+    let mut contact = Contact::Clear;
     for d in 0..D {
         let (lo, hi) = (container.min[d] + gap, container.max[d] - gap);
+        if x[d] < container.min[d] || x[d] > container.max[d] {
+            contact = Contact::Crossed;
+        } else if contact == Contact::Clear && (x[d] < lo || x[d] > hi) {
+            contact = Contact::Near;
+        }
         if x[d] < lo {
-            (x[d], u[d], moved) = (lo, u[d].max(0.0), true);
+            (x[d], u[d]) = (lo, u[d].max(0.0));
         } else if x[d] > hi {
-            (x[d], u[d], moved) = (hi, u[d].min(0.0), true);
+            (x[d], u[d]) = (hi, u[d].min(0.0));
         }
     }
     for o in obstacles {
         if !o.contains(x.as_slice()) {
             continue;
         }
-        // Out through the nearest face.
-        let (mut depth, mut exit) = (f64::INFINITY, (0, 0.0, 0.0));
-        for d in 0..D {
-            for (inside, sign) in [(x[d] - o.min[d], -1.0), (o.max[d] - x[d], 1.0)] {
+        // Out through the nearest face: along axis d, towards −1 (min face) or +1 (max face).
+        let (mut depth, mut d, mut sign) = (f64::INFINITY, 0, 0.0);
+        for axis in 0..D {
+            for (inside, s) in [(x[axis] - o.min[axis], -1.0), (o.max[axis] - x[axis], 1.0)] {
                 if inside < depth {
-                    depth = inside;
-                    exit = (
-                        d,
-                        sign,
-                        if sign < 0.0 {
-                            o.min[d] - gap
-                        } else {
-                            o.max[d] + gap
-                        },
-                    );
+                    (depth, d, sign) = (inside, axis, s);
                 }
             }
         }
-        let (d, sign, face) = exit;
-        x[d] = face;
+        x[d] = if sign < 0.0 {
+            o.min[d] - gap
+        } else {
+            o.max[d] + gap
+        };
         if u[d] * sign < 0.0 {
             u[d] = 0.0;
         }
-        moved = true;
+        contact = Contact::Crossed;
     }
-    moved
+    contact
 }
