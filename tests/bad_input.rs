@@ -1,31 +1,14 @@
 //! Bad input: one clear paragraph naming the file and key (and line), exit code ≠ 0, no panic,
 //! and nothing already written is touched.
 
-use crate::common::{isph_command, TempDir};
+use crate::common::{isph_command, water_block_scene, TempDir};
 use std::path::Path;
 use std::process::Output;
 
-const GOOD: &str = r#"[simulation]
-dimensions = 2
-spacing = 0.02
-end_time = 0.01
-output_interval = 0.01
-gravity = [0.0, -9.81]
-
-[[fluid]]
-name = "water"
-density = 1000.0
-viscosity = 1.0e-6
-
-[[fluid_block]]
-fluid = "water"
-min = [0.0, 0.0]
-max = [0.2, 0.2]
-
-[container]
-min = [0.0, 0.0]
-max = [0.4, 0.3]
-"#;
+/// A valid scene: one 10 × 10 block of water, run for a single frame.
+fn good() -> String {
+    water_block_scene(0.01)
+}
 
 fn isph(args: &[&str]) -> Output {
     isph_command().args(args).output().unwrap()
@@ -106,7 +89,7 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
         ),
     ];
     for (from, to, expected) in cases {
-        let (code, stderr) = run_text(dir.path(), &GOOD.replace(from, to), &[]);
+        let (code, stderr) = run_text(dir.path(), &good().replace(from, to), &[]);
         assert_refused(code, &stderr, expected);
         assert!(stderr.contains("scene.toml"), "file not named: {stderr}");
     }
@@ -129,7 +112,7 @@ fn an_unwritable_output_directory_is_refused() {
     let file = dir.path().join("a-file");
     std::fs::write(&file, "x").unwrap();
     let scene = dir.path().join("scene.toml");
-    std::fs::write(&scene, GOOD).unwrap();
+    std::fs::write(&scene, good()).unwrap();
     let out = file.join("out");
     let o = isph(&[
         "run",
@@ -149,17 +132,17 @@ fn an_unwritable_output_directory_is_refused() {
 #[test]
 fn an_existing_run_is_never_overwritten_by_accident() {
     let dir = TempDir::new("existing-run");
-    let (code, stderr) = run_text(dir.path(), GOOD, &[]);
+    let (code, stderr) = run_text(dir.path(), &good(), &[]);
     assert_eq!(code, 0, "{stderr}");
     let h5 = dir.path().join("out/particles.h5");
     let before = std::fs::read(&h5).unwrap();
-    let (code, stderr) = run_text(dir.path(), GOOD, &[]);
+    let (code, stderr) = run_text(dir.path(), &good(), &[]);
     assert_refused(code, &stderr, &["already holds a run", "--overwrite"]);
     assert_eq!(
         std::fs::read(&h5).unwrap(),
         before,
         "the earlier run was modified"
     );
-    let (code, stderr) = run_text(dir.path(), GOOD, &["--overwrite"]);
+    let (code, stderr) = run_text(dir.path(), &good(), &["--overwrite"]);
     assert_eq!(code, 0, "{stderr}");
 }

@@ -101,6 +101,35 @@ impl Drop for TempDir {
     }
 }
 
+/// A small 2D scene: a 10 × 10 block of water (dx = 0.02 m) in a 20 × 15 box, run to `end_time`
+/// with frames every 0.02 s (at most).
+pub fn water_block_scene(end_time: f64) -> String {
+    format!(
+        r#"[simulation]
+dimensions = 2
+spacing = 0.02
+end_time = {end_time}
+output_interval = {interval}
+gravity = [0.0, -9.81]
+
+[[fluid]]
+name = "water"
+density = 1000.0
+viscosity = 1.0e-6
+
+[[fluid_block]]
+fluid = "water"
+min = [0.0, 0.0]
+max = [0.2, 0.2]
+
+[container]
+min = [0.0, 0.0]
+max = [0.4, 0.3]
+"#,
+        interval = end_time.min(0.02)
+    )
+}
+
 /// Loads a scene shipped in `scenes/`.
 pub fn shipped_scene(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -2,38 +2,16 @@
 //! allocates only their arrays, `isph plan` says so, parameters of an effect that is off are
 //! refused, and a scene without `[effects]` runs as before.
 
-use crate::common::{run_scene, TempDir};
+use crate::common::{run_scene, water_block_scene, TempDir};
 use isph::plan::Plan;
 use isph::scene::Scene;
 use isph::simulation::Simulation;
 use isph::timings::Stage;
 use std::path::Path;
 
-/// A 10 × 10 block of water in a 20 × 15 box, then `effects` appended.
+/// A 10 × 10 block of water in a 20 × 15 box (`water_block_scene`), then `effects` appended.
 fn scene_text(effects: &str) -> String {
-    format!(
-        r#"[simulation]
-dimensions = 2
-spacing = 0.02
-end_time = 0.2
-output_interval = 0.02
-gravity = [0.0, -9.81]
-
-[[fluid]]
-name = "water"
-density = 1000.0
-viscosity = 1.0e-6
-
-[[fluid_block]]
-fluid = "water"
-min = [0.0, 0.0]
-max = [0.2, 0.2]
-
-[container]
-min = [0.0, 0.0]
-max = [0.4, 0.3]
-{effects}"#
-    )
+    water_block_scene(0.2) + effects
 }
 
 fn parse(effects: &str) -> Result<Scene, String> {
