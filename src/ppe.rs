@@ -18,7 +18,7 @@ use crate::multigrid::{cell_offset, stencil_slot, Aggregated};
 use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
-use crate::sph::{velocity_gradient, Correction, Corrections, Neighbours};
+use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Corrections, Neighbours};
 use crate::wall::{behind_walls, ghost_velocity};
 use wide::{f64x4, CmpNe};
 
@@ -243,7 +243,7 @@ fn laplacian_correction<const D: usize>(
 ) -> [f64; D] {
     let mut c = [0.0; D];
     nb.for_each(i, |j, rij, r| {
-        let cl = 2.0 * p.mass[j] / p.rest_density[i] * nb.laplacian_factor(r);
+        let cl = -laplacian_coefficient(nb, p, i, j, r);
         let followed = match p.kind[j] {
             Kind::Fluid => rij,
             Kind::Wall => behind_walls(p, j, rij),
