@@ -293,7 +293,7 @@ impl<const D: usize> PpeSetup<D> {
             std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MAX, f64::min) - support);
         let hi =
             std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MIN, f64::max) + support);
-        let mut grid = CellList::new(lo, hi, support);
+        let mut grid = CellList::new(lo, hi, support, [false; D]);
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
         grid.sort(&p.pos, &mut cells, &mut order)
             .expect("the grid spans the particles' bounding box");

@@ -3,14 +3,17 @@
 //! particle are 3^(D−1) contiguous index ranges of the particle arrays.
 
 use crate::memory::ArraySize;
+use rayon::prelude::*;
 use std::ops::Range;
 
 #[derive(Clone, Debug)]
 pub struct CellList<const D: usize> {
     /// Lower corner of cell (0, 0, …); the grid has one empty guard cell on each side.
     origin: [f64; D],
-    inv_cell: f64,
+    inv_cell: [f64; D],
     dims: [usize; D],
+    /// Per axis: the lower bound and length of the period of a periodic axis.
+    period: [Option<(f64, f64)>; D],
     /// Particles of cell c are `cell_start[c]..cell_start[c + 1]` (after `sort`).
     cell_start: Vec<u32>,
     /// Cell of each particle in the sorted order.
@@ -24,17 +27,50 @@ pub struct OutsideGrid {
 }
 
 impl<const D: usize> CellList<D> {
-    /// Grid over the box [lo, hi] with cells of edge ≥ `cell` (the kernel support).
-    pub fn new(lo: [f64; D], hi: [f64; D], cell: f64) -> Self {
-        let dims = std::array::from_fn(|d| ((hi[d] - lo[d]) / cell).ceil().max(1.0) as usize + 2);
-        let origin = std::array::from_fn(|d| lo[d] - cell);
+    /// Grid over the box [lo, hi] with cells of edge ≥ `cell` (the kernel support). Along a
+    /// periodic axis [lo, hi) is one period, split into whole cells (at least three: a
+    /// particle then never meets two images of another), and a neighbour search near one end
+    /// continues at the other.
+    pub fn new(lo: [f64; D], hi: [f64; D], cell: f64, periodic: [bool; D]) -> Self {
+        let count: [usize; D] =
+            std::array::from_fn(|d| ((hi[d] - lo[d]) / cell).ceil().max(1.0) as usize);
+        let period = std::array::from_fn(|d| periodic[d].then_some((lo[d], hi[d] - lo[d])));
+        let width: [f64; D] = std::array::from_fn(|d| match period[d] {
+            Some((_, length)) => {
+                let cells = (length / cell).floor();
+                assert!(cells >= 3.0, "a periodic axis spans at least three cells");
+                length / cells
+            }
+            None => cell,
+        });
+        let dims = std::array::from_fn(|d| match period[d] {
+            Some((_, length)) => (length / width[d]).round() as usize + 2,
+            None => count[d] + 2,
+        });
+        let origin = std::array::from_fn(|d| lo[d] - width[d]);
         let ncells: usize = dims.iter().product();
         Self {
             origin,
-            inv_cell: 1.0 / cell,
+            inv_cell: width.map(|w| 1.0 / w),
             dims,
+            period,
             cell_start: vec![0; ncells + 1],
             sorted_cell: Vec::new(),
+        }
+    }
+
+    /// Moves every position along a periodic axis back into its period [lo, lo + L).
+    pub fn wrap(&self, pos: &mut [Vec<f64>; D]) {
+        for d in 0..D {
+            if let Some((lo, length)) = self.period[d] {
+                pos[d].par_iter_mut().for_each(|x| {
+                    if *x < lo || *x >= lo + length {
+                        let r = (*x - lo).rem_euclid(length);
+                        // rem_euclid of a tiny negative number rounds up to the length itself.
+                        *x = lo + if r < length { r } else { 0.0 };
+                    }
+                });
+            }
         }
     }
 
@@ -63,7 +99,7 @@ impl<const D: usize> CellList<D> {
     pub fn cell_of(&self, x: [f64; D]) -> Option<usize> {
         let mut lin = 0;
         for d in (0..D).rev() {
-            let c = ((x[d] - self.origin[d]) * self.inv_cell).floor();
+            let c = ((x[d] - self.origin[d]) * self.inv_cell[d]).floor();
             if !(c >= 1.0 && c <= (self.dims[d] - 2) as f64) {
                 return None;
             }
@@ -110,34 +146,74 @@ impl<const D: usize> CellList<D> {
         Ok(())
     }
 
-    /// Calls `f` with the 3^(D−1) contiguous particle ranges covering the cells around `x`'s
-    /// cell (after `sort`; `x` must lie in an interior cell).
+    /// Calls `f(range, x′)` with the contiguous particle ranges covering the 3^D cells around
+    /// `x`'s cell (after `sort`; `x` must lie in an interior cell), with x′ the image of `x`
+    /// next to the range's particles: `x` itself, or shifted by a period where the cells around
+    /// it continue across a periodic boundary. Each row of three cells along x is one range,
+    /// or two where it wraps around a periodic x axis.
     #[inline]
-    pub fn for_each_neighbour_range(&self, x: [f64; D], mut f: impl FnMut(Range<usize>)) {
+    pub fn for_each_neighbour_range(&self, x: [f64; D], mut f: impl FnMut(Range<usize>, [f64; D])) {
         let c: [usize; D] =
-            std::array::from_fn(|d| ((x[d] - self.origin[d]) * self.inv_cell).floor() as usize);
+            std::array::from_fn(|d| ((x[d] - self.origin[d]) * self.inv_cell[d]).floor() as usize);
         let rows = 3usize.pow(D as u32 - 1);
         for row in 0..rows {
-            // Cell (c0 − 1, c1 + o1, c2 + o2) with o in {−1, 0, 1}.
-            let mut lin = 0;
-            let mut code = row;
-            let mut stride = 1;
-            for d in 0..D {
-                let cd = if d == 0 {
-                    c[0] - 1
-                } else {
-                    let o = code % 3;
-                    code /= 3;
-                    c[d] + o - 1
-                };
-                lin += cd * stride;
+            // Row (c0 − 1 ..= c0 + 1, c1 + o1, c2 + o2) with o in {−1, 0, 1}.
+            let mut image = x;
+            let (mut lin, mut code, mut stride) = (0, row, self.dims[0]);
+            for d in 1..D {
+                let o = code % 3;
+                code /= 3;
+                lin += self.wrapped(d, c[d] + o - 1, &mut image) * stride;
                 stride *= self.dims[d];
             }
-            let start = self.cell_start[lin] as usize;
-            let end = self.cell_start[lin + 3] as usize;
-            if start < end {
-                f(start..end);
+            let (first, last) = (c[0] - 1, c[0] + 1);
+            let mut emit = |from: usize, to: usize, image: [f64; D]| {
+                let start = self.cell_start[lin + from] as usize;
+                let end = self.cell_start[lin + to + 1] as usize;
+                if start < end {
+                    f(start..end, image);
+                }
+            };
+            let interior = self.dims[0] - 2;
+            match self.period[0] {
+                Some(_) if first == 0 => {
+                    emit(interior, interior, self.shifted(0, 1.0, image));
+                    emit(1, last, image);
+                }
+                Some(_) if last == interior + 1 => {
+                    emit(first, interior, image);
+                    emit(1, 1, self.shifted(0, -1.0, image));
+                }
+                _ => emit(first, last, image),
             }
         }
+    }
+
+    /// Cell index `k` along axis `d`, wrapped into the interior cells along a periodic axis
+    /// (with `image` moved by the period accordingly).
+    #[inline]
+    fn wrapped(&self, d: usize, k: usize, image: &mut [f64; D]) -> usize {
+        let interior = self.dims[d] - 2;
+        match self.period[d] {
+            Some(_) if k == 0 => {
+                *image = self.shifted(d, 1.0, *image);
+                interior
+            }
+            Some(_) if k == interior + 1 => {
+                *image = self.shifted(d, -1.0, *image);
+                1
+            }
+            _ => k,
+        }
+    }
+
+    /// `x` moved by `sign` periods along axis `d`: +1 when the cells it looks at wrapped to
+    /// the far end of the axis (their particles' images lie one period below them), −1 when
+    /// they wrapped to the first cell.
+    #[inline]
+    fn shifted(&self, d: usize, sign: f64, mut x: [f64; D]) -> [f64; D] {
+        let (_, length) = self.period[d].expect("a periodic axis");
+        x[d] += sign * length;
+        x
     }
 }

@@ -52,9 +52,19 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
         rest_density: wall_density,
         viscosity: 0.0,
     };
-    // Container walls: every lattice point within `layers` of the box, outside it.
-    let outer_lo = std::array::from_fn(|_| -layers);
-    let outer_hi = std::array::from_fn(|d| cells[d] + layers);
+    if let Some(field) = &scene.initial_velocity {
+        for i in 0..particles.len() {
+            let u = field.at(&scene.container, particles.position(i));
+            for d in 0..D {
+                particles.vel[d][i] = u[d];
+            }
+        }
+    }
+    // Container walls: every lattice point within `layers` of the box, outside it; none across
+    // a periodic axis.
+    let margin = |d: usize| if scene.periodic[d] { 0 } else { layers };
+    let outer_lo = std::array::from_fn(|d| -margin(d));
+    let outer_hi = std::array::from_fn(|d| cells[d] + margin(d));
     for_each_lattice_point(outer_lo, outer_hi, |k| {
         if (0..D).any(|d| k[d] < 0 || k[d] >= cells[d]) {
             particles.push(wall(point(k)));
@@ -68,6 +78,22 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
         }
     });
     particles
+}
+
+/// Whether the fluid fills the container: every lattice point inside it and outside the
+/// obstacles holds a fluid particle. Incompressible fluid that fills a closed or periodic box
+/// has no free surface, and can never make one.
+pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) -> bool {
+    let dx = scene.spacing;
+    let lo = &scene.container.min;
+    let cells: [i64; D] =
+        std::array::from_fn(|d| ((scene.container.max[d] - lo[d]) / dx).round() as i64);
+    let mut room = 0;
+    for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
+        let x: [f64; D] = std::array::from_fn(|d| lo[d] + (k[d] as f64 + 0.5) * dx);
+        room += !scene.obstacles.iter().any(|o| o.contains(&x)) as usize;
+    });
+    particles.fluid_count() == room
 }
 
 /// Calls `f` for every integer point k with lo ≤ k < hi, x fastest.

@@ -2,9 +2,8 @@
 //! neighbours of particle i lie in 3^(D−1) contiguous index ranges; the loop walks each range
 //! four particles at a time in SIMD lanes (`wide::f64x4`): positions are loaded contiguously,
 //! the distance test and the kernel are evaluated for four pairs at once, and each operator
-//! accumulates in lanes, summed at the end in a fixed order. Lanes past the end of a range hold
-//! particles of the next cells, at least one cell (one kernel support) away, so the distance
-//! test masks them; lanes past the end of the arrays read far-away sentinels.
+//! accumulates in lanes, summed at the end in a fixed order. Lanes past the end of a range (and
+//! past the end of the arrays, which read far-away sentinels) are masked off.
 //!
 //! `for_each` offers the same walk one neighbour at a time, for the operators that run once per
 //! step; the hot loops (the PPE apply, density, …) work on the lanes directly.
@@ -94,7 +93,8 @@ impl<'a, const D: usize> Neighbours<'a, D> {
     pub fn for_each_lanes(&self, i: usize, mut f: impl FnMut(&Lanes<D>)) {
         let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
         let support2 = f64x4::splat(self.support2);
-        self.grid.for_each_neighbour_range(xi, |range| {
+        // `xi` is i's image next to the range (itself but across a periodic boundary).
+        self.grid.for_each_neighbour_range(xi, |range, xi| {
             let mut j0 = range.start;
             while j0 < range.end {
                 let rij: [f64x4; D] =
@@ -102,9 +102,13 @@ impl<'a, const D: usize> Neighbours<'a, D> {
                 let r2 = rij.iter().fold(f64x4::ZERO, |s, x| x.mul_add(*x, s));
                 let mut mask = r2.cmp_lt(support2);
                 let own = i.wrapping_sub(j0);
-                if own < LANES {
+                if own < LANES || j0 + LANES > range.end {
                     let mut bits = mask.to_array();
-                    bits[own] = 0.0;
+                    for (k, bit) in bits.iter_mut().enumerate() {
+                        if j0 + k == i || j0 + k >= range.end {
+                            *bit = 0.0;
+                        }
+                    }
                     mask = f64x4::from(bits);
                 }
                 if mask.any() {

@@ -20,6 +20,7 @@ use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
 use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Corrections, Neighbours};
 use crate::wall::{behind_walls, ghost_velocity};
+use rayon::prelude::*;
 use wide::{f64x4, CmpNe};
 
 /// The role of a particle in the pressure solve.
@@ -33,6 +34,9 @@ pub enum Role {
     Splash,
     /// Wall particle: no unknown.
     Wall,
+    /// The one fluid particle pinned to P = 0 where the fluid has no free surface at all (a
+    /// closed or periodic box), whose PPE fixes the pressure only up to a constant.
+    Reference,
 }
 
 impl Role {
@@ -47,7 +51,7 @@ impl Role {
         match self {
             Role::Surface => 1,
             Role::Splash => 2,
-            Role::Interior | Role::Wall => 0,
+            Role::Interior | Role::Wall | Role::Reference => 0,
         }
     }
 
@@ -77,18 +81,23 @@ pub fn fluid_volumes<const D: usize>(p: &Particles<D>, out: &mut Vec<f64>) {
 /// Assigns roles: fluid on the free surface (see `free_surface`) takes the surface row, or P = 0
 /// where it has no consistent gradient (`gradient_defined` false: the moment matrix of its
 /// pressure gradient is near-singular, whether or not the scene applies the kernel correction).
-/// If the fluid has no free surface at all (a full closed box) the PPE is singular; the highest
-/// fluid particle is then pinned to P = 0.
+/// Fluid that fills its container (`confined`) has no free surface: every fluid row is
+/// interior (a disordered patch of a periodic flow can look like a surface to the detection).
+/// If the fluid has no free surface at all (a full closed or periodic box) the PPE is singular;
+/// the highest fluid particle (the first in index order among equals) is then the reference,
+/// pinned to P = 0.
 pub fn assign_roles<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     supports: &[Support<D>],
     gradient_defined: &[bool],
     gravity: [f64; D],
+    confined: bool,
     roles: &mut Vec<Role>,
 ) {
     roles.resize(p.len(), Role::Wall);
     fill(roles, |i| match p.kind[i] {
+        Kind::Fluid if confined => Role::Interior,
         Kind::Fluid => {
             let mut fluid_neighbours = 0;
             nb.for_each(i, |j, _, _| fluid_neighbours += p.is_fluid(j) as usize);
@@ -109,7 +118,7 @@ pub fn assign_roles<const D: usize>(
             .filter(|&i| roles[i] == Role::Interior)
             .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)));
         if let Some(top) = top {
-            roles[top] = Role::Splash;
+            roles[top] = Role::Reference;
         }
     }
 }
@@ -143,7 +152,7 @@ pub fn row_vectors<const D: usize>(
 ) {
     fill_vector(out, |i| match roles[i] {
         Role::Interior => laplacian_correction(nb, p, pressure_corrections.of(i), i),
-        Role::Surface | Role::Splash | Role::Wall => [0.0; D],
+        Role::Surface | Role::Splash | Role::Wall | Role::Reference => [0.0; D],
     });
 }
 
@@ -180,8 +189,38 @@ pub fn source<const D: usize>(
                 + op.wall_source(i)
         }
         Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
-        Role::Splash | Role::Wall => 0.0,
+        Role::Splash | Role::Wall | Role::Reference => 0.0,
     });
+    if is_closed(op.roles) {
+        remove_net_compression(op.roles, b);
+    }
+}
+
+/// Whether the fluid has no free surface: its pressure is then fixed by the reference particle.
+pub fn is_closed(roles: &[Role]) -> bool {
+    roles.contains(&Role::Reference)
+}
+
+/// In a closed box the interior rows' sources must sum to zero: the volume cannot change, and
+/// a net source would have nowhere to go but the reference particle's row (a spurious point
+/// source of pressure there). The SPH divergence and the density term leave a small net sum
+/// (from the disorder of the particles); it is removed evenly from every interior row.
+fn remove_net_compression(roles: &[Role], b: &mut [f64]) {
+    let [count, sum] = crate::reduce::sums(b.len(), |i| {
+        if roles[i] == Role::Interior {
+            [1.0, b[i]]
+        } else {
+            [0.0; 2]
+        }
+    });
+    if count > 0.0 {
+        let mean = sum / count;
+        b.par_iter_mut().zip(roles).for_each(|(b, &role)| {
+            if role == Role::Interior {
+                *b -= mean;
+            }
+        });
+    }
 }
 
 /// −(ρ0/Δt) ∇·u* − α (ρ0 − ρ_i)/Δt², Eq. (6), with ∇·u* corrected by Eq. (24)–(25) so that it
@@ -336,7 +375,7 @@ impl<const D: usize> PressureOperator<'_, D> {
                 });
                 ax.reduce_add()
             }
-            Role::Surface | Role::Splash | Role::Wall => x[i],
+            Role::Surface | Role::Splash | Role::Wall | Role::Reference => x[i],
         }
     }
 }
@@ -367,7 +406,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
                         1.0
                     }
                 }
-                Role::Surface | Role::Splash | Role::Wall => 1.0,
+                Role::Surface | Role::Splash | Role::Wall | Role::Reference => 1.0,
             }
         })
     }
@@ -381,7 +420,7 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
     fn aggregate(&self, i: usize) -> Option<usize> {
         match self.roles[i] {
             Role::Interior => Some(self.nb.grid().cell_of_sorted(i)),
-            Role::Surface | Role::Splash | Role::Wall => None,
+            Role::Surface | Role::Splash | Role::Wall | Role::Reference => None,
         }
     }
 
@@ -401,9 +440,12 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
                 }
                 row[centre] += w;
                 let j = l.j0 + k;
-                if self.aggregate(j).is_some() {
-                    let slot = stencil_slot(cell_offset(dims, cell, grid.cell_of_sorted(j)));
-                    row[slot] -= w;
+                // A coupling across a periodic boundary joins cells at the two ends of the grid,
+                // outside the 3^D stencil: the coarse levels leave it out (their row keeps its
+                // diagonal), which only weakens the preconditioner near that boundary.
+                let offset = cell_offset(dims, cell, grid.cell_of_sorted(j));
+                if self.aggregate(j).is_some() && offset.iter().all(|o| o.abs() <= 1) {
+                    row[stencil_slot(offset)] -= w;
                 }
             }
         });

@@ -1,6 +1,7 @@
 //! Scene files: TOML in SI units, parsed with unknown keys rejected, then validated into a
 //! `Scene`. Every error names the file, the key and, where it can be found, the line.
 
+use crate::kernel::SUPPORT_IN_H;
 use crate::shifting::ShiftingSettings;
 use crate::turbulence::LesSettings;
 use serde::Deserialize;
@@ -32,9 +33,10 @@ struct SceneFile {
     fluid: Vec<Fluid>,
     #[serde(default)]
     fluid_block: Vec<FluidBlock>,
-    container: BoxSection,
+    container: ContainerSection,
     #[serde(default)]
     obstacle: Vec<BoxSection>,
+    initial_velocity: Option<InitialVelocitySection>,
     #[serde(default)]
     solver: SolverSettings,
     #[serde(default)]
@@ -78,6 +80,45 @@ struct FluidBlock {
 struct BoxSection {
     min: Vec<f64>,
     max: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ContainerSection {
+    min: Vec<f64>,
+    max: Vec<f64>,
+    periodic: Option<Vec<bool>>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InitialVelocitySection {
+    field: String,
+    amplitude: f64,
+}
+
+/// A velocity field the fluid starts with instead of rest.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InitialVelocity {
+    /// The 2D Taylor–Green vortex of the periodic square [x0, x0 + L)²:
+    /// u = U sin(kx′) cos(ky′), v = −U cos(kx′) sin(ky′), k = 2π/L, x′ = x − x0.
+    TaylorGreen { amplitude: f64 },
+}
+
+impl InitialVelocity {
+    /// The velocity at x inside `container`.
+    pub fn at<const D: usize>(&self, container: &Aabb, x: [f64; D]) -> [f64; D] {
+        match *self {
+            InitialVelocity::TaylorGreen { amplitude } => {
+                let k = 2.0 * std::f64::consts::PI / (container.max[0] - container.min[0]);
+                let (a, b) = (k * (x[0] - container.min[0]), k * (x[1] - container.min[1]));
+                let mut u = [0.0; D];
+                u[0] = amplitude * a.sin() * b.cos();
+                u[1] = -amplitude * a.cos() * b.sin();
+                u
+            }
+        }
+    }
 }
 
 /// The `[solver]` section: pressure solve, relaxation and time step.
@@ -235,7 +276,12 @@ pub struct Scene {
     pub fluids: Vec<Fluid>,
     pub blocks: Vec<Block>,
     pub container: Aabb,
+    /// Per axis: whether the container is periodic along it (no walls on its two faces; what
+    /// leaves through one comes back through the other).
+    pub periodic: Vec<bool>,
     pub obstacles: Vec<Aabb>,
+    /// The fluid's velocity at t = 0 (None: at rest).
+    pub initial_velocity: Option<InitialVelocity>,
     pub solver: SolverSettings,
     pub checkpoint: CheckpointSettings,
     pub effects: Effects,
@@ -411,7 +457,17 @@ impl Validator<'_> {
             )?;
         }
 
-        let container = self.aabb(&f.container, dims, "container", s.spacing)?;
+        let container_box = BoxSection {
+            min: f.container.min.clone(),
+            max: f.container.max.clone(),
+        };
+        let container = self.aabb(&container_box, dims, "container", s.spacing)?;
+        let periodic = self.periodic(
+            f.container.periodic.as_deref(),
+            &container,
+            s.spacing,
+            &f.solver,
+        )?;
         self.check(
             !f.fluid_block.is_empty(),
             "fluid_block",
@@ -484,6 +540,11 @@ impl Validator<'_> {
             format!("= {} must lie in [1, 2]", sv.h_over_dx),
         )?;
 
+        let initial_velocity = f
+            .initial_velocity
+            .as_ref()
+            .map(|v| self.initial_velocity(v, &container, &periodic))
+            .transpose()?;
         let checkpoint = self.checkpoint(&f.checkpoint)?;
         let effects = self.effects(&f.effects)?;
 
@@ -506,10 +567,88 @@ impl Validator<'_> {
             fluids: f.fluid,
             blocks,
             container,
+            periodic,
             obstacles,
+            initial_velocity,
             solver: f.solver,
             checkpoint,
             effects,
+        })
+    }
+
+    /// `container.periodic`: one flag per axis. A periodic axis must hold a whole number of
+    /// particle spacings (the lattice must close on itself) and at least three kernel supports
+    /// (three cells of the cell list, so that a particle never meets two images of another).
+    fn periodic(
+        &self,
+        flags: Option<&[bool]>,
+        container: &Aabb,
+        spacing: f64,
+        solver: &SolverSettings,
+    ) -> Result<Vec<bool>, SceneError> {
+        let dims = container.min.len();
+        let Some(flags) = flags else {
+            return Ok(vec![false; dims]);
+        };
+        let key = "container.periodic";
+        self.check(
+            flags.len() == dims,
+            key,
+            format!(
+                "has {} flags but the scene has `simulation.dimensions = {dims}`",
+                flags.len()
+            ),
+        )?;
+        let support = SUPPORT_IN_H * solver.h_over_dx * spacing;
+        for d in (0..dims).filter(|&d| flags[d]) {
+            let length = container.max[d] - container.min[d];
+            let spacings = length / spacing;
+            self.check(
+                (spacings - spacings.round()).abs() < 1e-6 * spacings,
+                key,
+                format!("axis {d} is periodic, so its length {length} m must be a whole number of spacings ({spacing} m); it is {spacings}"),
+            )?;
+            self.check(
+                length >= 3.0 * support,
+                key,
+                format!("axis {d} is periodic, so its length {length} m must be at least three kernel supports (3 × 3h = {} m)", 3.0 * support),
+            )?;
+        }
+        Ok(flags.to_vec())
+    }
+
+    /// `[initial_velocity]`: a named analytic field and its amplitude.
+    fn initial_velocity(
+        &self,
+        v: &InitialVelocitySection,
+        container: &Aabb,
+        periodic: &[bool],
+    ) -> Result<InitialVelocity, SceneError> {
+        self.check(
+            v.field == "taylor_green",
+            "initial_velocity.field",
+            format!(
+                "= \"{}\" is not a known field; known: \"taylor_green\"",
+                v.field
+            ),
+        )?;
+        let lengths: Vec<f64> = (0..container.min.len())
+            .map(|d| container.max[d] - container.min[d])
+            .collect();
+        self.check(
+            lengths.len() == 2
+                && periodic.iter().all(|&p| p)
+                && (lengths[0] - lengths[1]).abs() <= 1e-9 * lengths[0],
+            "initial_velocity.field",
+            "= \"taylor_green\" needs a 2D container periodic in both axes (`container.periodic = [true, true]`) and square",
+        )?;
+        self.check(
+            v.amplitude.is_finite(),
+            "initial_velocity.amplitude",
+            format!("= {} must be a finite number [m/s]", v.amplitude),
+        )?;
+        Ok(InitialVelocity::TaylorGreen {
+            amplitude: v.amplitude,
         })
     }
 

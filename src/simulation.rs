@@ -77,6 +77,7 @@ pub struct Simulation<const D: usize> {
     grid: CellList<D>,
     settings: StepSettings<D>,
     container: Aabb,
+    periodic: [bool; D],
     obstacles: Vec<Aabb>,
     cfl: f64,
     max_viscosity: f64,
@@ -101,16 +102,21 @@ impl<const D: usize> Simulation<D> {
                 path: scene.path.clone(),
             });
         }
+        let confined = lattice::fills_container(scene, &particles);
         let h = scene.smoothing_length();
-        let margin = (lattice::wall_layers(scene) as f64 + 1.0) * scene.spacing;
-        let lo = std::array::from_fn(|d| scene.container.min[d] - margin);
-        let hi = std::array::from_fn(|d| scene.container.max[d] + margin);
+        // Bounded axes: room for the wall layers and a spacing more; a periodic axis is one
+        // period, the container's extent.
+        let periodic: [bool; D] = std::array::from_fn(|d| scene.periodic[d]);
+        let walls = (lattice::wall_layers(scene) as f64 + 1.0) * scene.spacing;
+        let margin = |d: usize| if periodic[d] { 0.0 } else { walls };
+        let lo = std::array::from_fn(|d| scene.container.min[d] - margin(d));
+        let hi = std::array::from_fn(|d| scene.container.max[d] + margin(d));
         Ok(Self {
             particles,
             time: 0.0,
             step: 0,
             kernel: Quintic::new(h),
-            grid: CellList::new(lo, hi, SUPPORT_IN_H * h),
+            grid: CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
             settings: StepSettings {
                 gravity: std::array::from_fn(|d| scene.gravity[d]),
                 spacing: scene.spacing,
@@ -120,8 +126,10 @@ impl<const D: usize> Simulation<D> {
                     max_iterations: scene.solver.max_iterations,
                 },
                 effects: scene.effects,
+                confined,
             },
             container: scene.container.clone(),
+            periodic,
             obstacles: scene.obstacles.clone(),
             cfl: scene.solver.cfl,
             max_viscosity: scene.fluids.iter().map(|f| f.viscosity).fold(0.0, f64::max),
@@ -166,9 +174,11 @@ impl<const D: usize> Simulation<D> {
         Ok(dt)
     }
 
-    /// Re-sorts the particles by cell, permuting every array together.
+    /// Re-sorts the particles by cell, permuting every array together; particles that left
+    /// through a periodic boundary come back through the opposite one first.
     fn sort_by_cell(&mut self) -> Result<(), NumericalFailure> {
         let clock = Instant::now();
+        self.grid.wrap(&mut self.particles.pos);
         if let Err(out) = self
             .grid
             .sort(&self.particles.pos, &mut self.cell_of, &mut self.order)
@@ -289,7 +299,14 @@ impl<const D: usize> Simulation<D> {
                 continue;
             }
             let (mut x, mut u) = (p.position(i), p.velocity(i));
-            match wall::face_contact(&self.container, &self.obstacles, gap, &mut x, &mut u) {
+            match wall::face_contact(
+                &self.container,
+                self.periodic,
+                &self.obstacles,
+                gap,
+                &mut x,
+                &mut u,
+            ) {
                 Contact::Clear => continue,
                 Contact::Near => {}
                 Contact::Crossed => penetrations += 1,

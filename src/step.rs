@@ -36,6 +36,9 @@ pub struct StepSettings<const D: usize> {
     pub solver: SolverParams,
     /// The optional stages and their constants.
     pub effects: Effects,
+    /// The fluid fills a closed or periodic container (`lattice::fills_container`): it has no
+    /// free surface, and none is looked for.
+    pub confined: bool,
 }
 
 /// The stages of a step of a scene with `effects`, in order: those of `Workspace::project`,
@@ -173,7 +176,8 @@ impl<const D: usize> Workspace<D> {
             self.predict(&nb, p, set, dt);
             lap(Stage::Predictor);
             let solve = self.solve_pressure(&nb, p, set, dt)?;
-            fill(&mut p.pressure, |i| self.pressure[i].max(0.0));
+            let clip = !ppe::is_closed(&self.roles);
+            fill(&mut p.pressure, |i| cavitation(clip, self.pressure[i]));
             lap(Stage::PressureSolve);
             self.correct(&nb, p, set, dt);
             std::mem::swap(&mut p.vel, &mut self.velocity);
@@ -320,6 +324,7 @@ impl<const D: usize> Workspace<D> {
             &self.supports,
             &self.gradient_defined,
             set.gravity,
+            set.confined,
             &mut self.roles,
         );
         ppe::full_support(nb, &self.roles, &mut self.full_support);
@@ -373,7 +378,7 @@ impl<const D: usize> Workspace<D> {
         let wall_function = les.is_some_and(|les| les.wall_function);
         fill_vector(&mut self.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
-                let visc = sph::viscous_acceleration(nb, p, eddy, i);
+                let visc = sph::viscous_acceleration(nb, p, eddy, spacing, i);
                 let wall = if wall_function {
                     turbulence::wall_shear(nb, p, spacing, i)
                 } else {
@@ -427,17 +432,26 @@ impl<const D: usize> Workspace<D> {
             &mut self.rhs,
         );
         let roles = &self.roles;
+        // In a closed box the last pressure is shifted to the new reference's level.
+        let level = roles
+            .iter()
+            .position(|&r| r == Role::Reference)
+            .map_or(0.0, |r| p.pressure[r]);
         fill(&mut self.pressure, |i| match roles[i] {
-            Role::Interior | Role::Surface => p.pressure[i],
-            Role::Splash | Role::Wall => 0.0,
+            Role::Interior | Role::Surface => p.pressure[i] - level,
+            Role::Splash | Role::Wall | Role::Reference => 0.0,
         });
-        self.bicgstab.solve(
+        let info = self.bicgstab.solve(
             &op,
             &mut self.multigrid,
             &self.rhs,
             &mut self.pressure,
             set.solver,
-        )
+        )?;
+        if ppe::is_closed(roles) {
+            zero_mean_pressure(p, &mut self.pressure);
+        }
+        Ok(info)
     }
 
     /// Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls
@@ -525,7 +539,7 @@ impl<const D: usize> Workspace<D> {
         fill_vector(&mut self.shift, |i| match roles[i] {
             // Splashes are left in place: neither ∇C nor the Taylor correction means anything
             // there.
-            Role::Interior | Role::Surface => {
+            Role::Interior | Role::Surface | Role::Reference => {
                 let dr = shifting.displacement(nb, p, &supports[i], full[i], i);
                 wall::no_penetration(dr, vector(contact, i))
             }
@@ -555,11 +569,15 @@ impl<const D: usize> Workspace<D> {
         });
         let pressure_corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
+        let clip = !ppe::is_closed(roles);
         fill(&mut self.pressure, |i| match p.kind[i] {
             Kind::Fluid => {
                 let g = pressure_gradient(nb, p, set.gravity, pressure_corrections.of(i), i);
                 let dr = vector(shift, i);
-                (p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>()).max(0.0)
+                cavitation(
+                    clip,
+                    p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>(),
+                )
             }
             Kind::Wall => p.pressure[i],
         });
@@ -597,6 +615,38 @@ fn pressure_gradient<const D: usize>(
         Kind::Fluid => p.pressure[j] - p.pressure[i],
         Kind::Wall => wall::ghost_pressure_difference(p, gravity, i, j, rij),
     })
+}
+
+/// The pressure the fluid takes: with a free surface the pressure is absolute (zero at the
+/// surface) and the water cannot hold a tension, so negative pressures are cut to zero; in a
+/// closed box (`clip` false) only differences count and P is kept as solved.
+#[inline]
+fn cavitation(clip: bool, pressure: f64) -> f64 {
+    if clip {
+        pressure.max(0.0)
+    } else {
+        pressure
+    }
+}
+
+/// Shifts the fluid pressures of a closed box to a zero mean (walls hold no unknown): the
+/// PPE fixes them only up to a constant, and a pressure level that does not depend on which
+/// particle happened to be the reference keeps the frames comparable.
+fn zero_mean_pressure<const D: usize>(p: &Particles<D>, pressure: &mut [f64]) {
+    let [volume, integral] = reduce::sums(p.len(), |i| {
+        if p.is_fluid(i) {
+            let v = p.mass[i] / p.rest_density[i];
+            [v, v * pressure[i]]
+        } else {
+            [0.0; 2]
+        }
+    });
+    let mean = integral / volume;
+    pressure.par_iter_mut().zip(&p.kind).for_each(|(x, &kind)| {
+        if kind == Kind::Fluid {
+            *x -= mean;
+        }
+    });
 }
 
 /// Component vector i of a SoA vector field.

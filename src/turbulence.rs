@@ -76,17 +76,13 @@ pub fn wall_shear<const D: usize>(
     spacing: f64,
     i: usize,
 ) -> [f64; D] {
-    let Some((b, r_ib)) = wall::nearest_wall(nb, p, 1.5 * spacing, i) else {
+    let Some((y, n)) = wall::face_distance(nb, p, spacing, 1.5 * spacing, i) else {
         return [0.0; D];
     };
-    let n = p.wall_normal(b);
     let u = p.velocity(i);
     let u_n: f64 = (0..D).map(|d| u[d] * n[d]).sum();
     let u_t: [f64; D] = std::array::from_fn(|d| u[d] - u_n * n[d]);
     let speed = u_t.iter().map(|x| x * x).sum::<f64>().sqrt();
-    // The wall surface lies half a spacing beyond the centre of the first wall layer.
-    let depth: f64 = (0..D).map(|d| r_ib[d] * n[d]).sum();
-    let y = (depth - 0.5 * spacing).max(0.25 * spacing);
     let nu = p.viscosity[i];
     if speed == 0.0 || nu == 0.0 {
         return [0.0; D];

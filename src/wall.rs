@@ -102,6 +102,22 @@ pub fn nearest_wall<const D: usize>(
     nearest.1
 }
 
+/// Distance from fluid particle i to the face of the nearest wall whose particles come closer
+/// than `within`, with that wall's normal: the nearest wall particle's separation along its
+/// normal less the half spacing from a wall particle's centre to the face, and at least a
+/// quarter spacing (a particle pressed against the face).
+pub fn face_distance<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    spacing: f64,
+    within: f64,
+    i: usize,
+) -> Option<(f64, [f64; D])> {
+    let (b, r_ib) = nearest_wall(nb, p, within, i)?;
+    let n = p.wall_normal(b);
+    Some(((dot(r_ib, n) - 0.5 * spacing).max(0.25 * spacing), n))
+}
+
 /// The wall a fluid particle touches: the normal of the nearest wall particle closer than the
 /// spacing dx (nearer than at rest), or zero where there is none.
 pub fn contact_normal<const D: usize>(
@@ -122,7 +138,7 @@ pub fn no_penetration<const D: usize>(v: [f64; D], n: [f64; D]) -> [f64; D] {
     std::array::from_fn(|d| v[d] - v_n * n[d])
 }
 
-fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
+pub fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
     (0..D).map(|d| a[d] * b[d]).sum()
 }
 
@@ -170,13 +186,15 @@ pub enum Contact {
 /// contact, as `no_penetration`).
 pub fn face_contact<const D: usize>(
     container: &Aabb,
+    periodic: [bool; D],
     obstacles: &[Aabb],
     gap: f64,
     x: &mut [f64; D],
     u: &mut [f64; D],
 ) -> Contact {
     let mut contact = Contact::Clear;
-    for d in 0..D {
+    // A periodic axis has no faces.
+    for d in (0..D).filter(|&d| !periodic[d]) {
         let (lo, hi) = (container.min[d] + gap, container.max[d] - gap);
         if x[d] < container.min[d] || x[d] > container.max[d] {
             contact = Contact::Crossed;

@@ -83,6 +83,30 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             &["unknown field `colour`", "line 12"],
         ),
         (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\nperiodic = [true]",
+            &["container.periodic", "scene.toml:21", "1 flags"],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.41, 0.3]\nperiodic = [true, false]",
+            &["container.periodic", "axis 0", "whole number of spacings"],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[initial_velocity]\nfield = \"taylor_green\"\namplitude = 1.0",
+            &[
+                "initial_velocity.field",
+                "scene.toml:23",
+                "periodic in both axes",
+            ],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[initial_velocity]\nfield = \"vortex\"\namplitude = 1.0",
+            &["initial_velocity.field", "\"vortex\"", "taylor_green"],
+        ),
+        (
             "end_time = 0.01",
             "end_time = [0.01",
             &["line 5", "TOML parse error", "expected `]`"],

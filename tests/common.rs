@@ -55,7 +55,12 @@ impl<const D: usize> Lattice<D> {
         }
         let kernel = Quintic::<D>::new(h_over_dx * dx);
         let extent = extent + 2.0 * dx;
-        let mut grid = CellList::new([-extent; D], [extent; D], SUPPORT_IN_H * kernel.h());
+        let mut grid = CellList::new(
+            [-extent; D],
+            [extent; D],
+            SUPPORT_IN_H * kernel.h(),
+            [false; D],
+        );
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
         grid.sort(&particles.pos, &mut cells, &mut order)
             .expect("lattice inside grid");

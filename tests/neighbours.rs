@@ -13,7 +13,9 @@ fn lcg(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
-fn check<const D: usize>(n: usize) {
+/// The cell-list neighbours of n pseudo-random particles in the unit box against a brute-force
+/// search, with the minimum image along the periodic axes (and the pair vector r_ij too).
+fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
     let mut seed = 42;
     let mut p = Particles::<D>::default();
     for _ in 0..n {
@@ -28,34 +30,57 @@ fn check<const D: usize>(n: usize) {
             viscosity: 0.0,
         });
     }
-    let kernel = Quintic::<D>::new(0.04);
-    let mut grid = CellList::new([0.0; D], [1.0; D], SUPPORT_IN_H * kernel.h());
+    let kernel = Quintic::<D>::new(h);
+    let mut grid = CellList::new([0.0; D], [1.0; D], SUPPORT_IN_H * kernel.h(), periodic);
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
     grid.sort(&p.pos, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);
     let nb = Neighbours::new(&grid, &p.pos, kernel);
     let s2 = kernel.support().powi(2);
+    // r_ij with the nearest image of j along the periodic axes.
+    let image = |i: usize, j: usize| -> [f64; D] {
+        std::array::from_fn(|d| {
+            let r = p.pos[d][i] - p.pos[d][j];
+            if periodic[d] {
+                r - r.round()
+            } else {
+                r
+            }
+        })
+    };
     for i in 0..n {
         let mut fast = Vec::new();
-        nb.for_each(i, |j, _, _| fast.push(j));
-        fast.sort();
+        nb.for_each(i, |j, rij, _| fast.push((j, rij)));
+        fast.sort_by_key(|&(j, _)| j);
         let slow: Vec<usize> = (0..n)
-            .filter(|&j| {
-                j != i
-                    && (0..D)
-                        .map(|d| (p.pos[d][i] - p.pos[d][j]).powi(2))
-                        .sum::<f64>()
-                        < s2
-            })
+            .filter(|&j| j != i && image(i, j).iter().map(|x| x * x).sum::<f64>() < s2)
             .collect();
-        assert_eq!(fast, slow, "neighbours of particle {i}");
+        let found: Vec<usize> = fast.iter().map(|&(j, _)| j).collect();
+        assert_eq!(found, slow, "neighbours of particle {i}");
+        for (j, rij) in fast {
+            let expected = image(i, j);
+            assert!(
+                (0..D).all(|d| (rij[d] - expected[d]).abs() < 1e-12),
+                "r_ij of pair {i}, {j}"
+            );
+        }
     }
 }
 
 #[test]
 fn cell_list_finds_exactly_the_brute_force_neighbours() {
-    check::<2>(3000);
-    check::<3>(3000);
+    check::<2>(3000, 0.04, [false; 2]);
+    check::<3>(3000, 0.04, [false; 3]);
+}
+
+#[test]
+fn periodic_axes_find_the_nearest_images_across_the_boundary() {
+    check::<2>(3000, 0.04, [true, true]);
+    check::<2>(3000, 0.04, [true, false]);
+    check::<3>(3000, 0.04, [false, true, true]);
+    // Three cells per periodic axis, the fewest allowed: no neighbour is met twice.
+    check::<2>(400, 0.1, [true, true]);
+    check::<3>(400, 0.1, [true, true, true]);
 }
 
 #[test]
@@ -72,7 +97,7 @@ fn sort_keeps_ids_and_reports_particles_outside() {
             viscosity: 0.0,
         });
     }
-    let mut grid = CellList::new([0.0; 2], [1.0; 2], 0.1);
+    let mut grid = CellList::new([0.0; 2], [1.0; 2], 0.1, [false; 2]);
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
     grid.sort(&p.pos, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);
