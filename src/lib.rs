@@ -28,4 +28,5 @@ pub mod sph;
 pub mod step;
 pub mod timings;
 pub mod turbulence;
+pub mod validation;
 pub mod wall;

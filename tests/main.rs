@@ -16,4 +16,5 @@ mod neighbours;
 mod operators;
 mod output_readers;
 mod stability;
+mod validation;
 mod wall_contact;
