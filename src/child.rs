@@ -44,10 +44,9 @@ impl RunReport {
 
 /// The peak resident set size of this process so far (VmHWM).
 pub fn peak_resident_bytes() -> Result<u64, ChildError> {
-    let status =
-        std::fs::read_to_string("/proc/self/status").map_err(|e| ChildError::Memory {
-            message: e.to_string(),
-        })?;
+    let status = std::fs::read_to_string("/proc/self/status").map_err(|e| ChildError::Memory {
+        message: e.to_string(),
+    })?;
     status
         .lines()
         .find_map(|l| l.strip_prefix("VmHWM:"))

@@ -86,7 +86,10 @@ fn identity(pid: u32) -> Option<String> {
 
 /// Whether the process that wrote the claim `holder` still runs.
 fn is_alive(holder: &str) -> bool {
-    let pid = holder.split_whitespace().next().and_then(|p| p.parse().ok());
+    let pid = holder
+        .split_whitespace()
+        .next()
+        .and_then(|p| p.parse().ok());
     pid.and_then(identity)
         .is_some_and(|now| now.trim() == holder.trim())
 }

@@ -74,7 +74,11 @@ impl Study {
         let scene_text = std::fs::read_to_string(&scene_path).map_err(|e| {
             invalid(
                 "scene",
-                format!("= \"{}\": cannot read {}: {e}", file.scene.display(), scene_path.display()),
+                format!(
+                    "= \"{}\": cannot read {}: {e}",
+                    file.scene.display(),
+                    scene_path.display()
+                ),
             )
         })?;
         Scene::parse(&scene_text, &scene_path)
@@ -83,9 +87,8 @@ impl Study {
             check_values(key, values).map_err(|m| invalid(&format!("grid.\"{key}\""), m))?;
             for value in values {
                 let setting = [(key.clone(), value.clone())];
-                scene_with(&scene_text, &scene_path, &setting).map_err(|m| {
-                    invalid(&format!("grid.\"{key}\""), format!("= {value}: {m}"))
-                })?;
+                scene_with(&scene_text, &scene_path, &setting)
+                    .map_err(|m| invalid(&format!("grid.\"{key}\""), format!("= {value}: {m}")))?;
             }
         }
         let keys: Vec<String> = file.grid.keys().cloned().collect();
@@ -159,7 +162,10 @@ fn product(grid: &BTreeMap<String, Vec<toml::Value>>) -> Vec<Vec<(String, toml::
 /// 12 hex digits of the XXH3-64 of the settings as `key = value` lines: the same settings give
 /// the same id in every run of the study.
 pub fn point_id(settings: &[(String, toml::Value)]) -> String {
-    let mut sorted: Vec<String> = settings.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
+    let mut sorted: Vec<String> = settings
+        .iter()
+        .map(|(k, v)| format!("{k} = {v}\n"))
+        .collect();
     sorted.sort();
     let hash = xxhash_rust::xxh3::xxh3_64(sorted.concat().as_bytes());
     format!("{hash:016x}")[..12].to_owned()

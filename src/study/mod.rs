@@ -101,7 +101,12 @@ pub fn run(
     table::ensure(&csv, &columns(&study))?;
     let total = study.points.len();
     for (k, point) in study.points.iter().enumerate() {
-        let what = format!("[{}/{total}] {} ({})", k + 1, point.id, label(&point.settings));
+        let what = format!(
+            "[{}/{total}] {} ({})",
+            k + 1,
+            point.id,
+            label(&point.settings)
+        );
         if done(&csv)?.contains_key(&point.id) {
             continue;
         }
@@ -157,7 +162,14 @@ fn columns(study: &Study) -> Vec<String> {
     c.push("error".into());
     c.extend(study.case.detail_names().iter().map(|d| d.to_string()));
     c.extend(
-        ["wall_seconds", "steps", "ppe_iterations_mean", "peak_bytes", "status"].map(String::from),
+        [
+            "wall_seconds",
+            "steps",
+            "ppe_iterations_mean",
+            "peak_bytes",
+            "status",
+        ]
+        .map(String::from),
     );
     c
 }
@@ -198,7 +210,9 @@ fn run_point(
     let text = |v: Option<String>| v.unwrap_or_default();
     let mut row = vec![point.id.clone()];
     row.extend(point.settings.iter().map(|(_, v)| v.to_string()));
-    row.push(text(result.measured.as_ref().map(|m| format!("{:e}", m.error))));
+    row.push(text(
+        result.measured.as_ref().map(|m| format!("{:e}", m.error)),
+    ));
     for name in study.case.detail_names() {
         let value = result
             .measured

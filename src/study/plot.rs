@@ -38,9 +38,10 @@ pub fn pareto(outcomes: &[Outcome]) -> Vec<bool> {
         .iter()
         .map(|p| {
             p.is_some_and(|(t, e)| {
-                !points.iter().flatten().any(|&(t2, e2)| {
-                    t2 <= t && e2 <= e && (t2 < t || e2 < e)
-                })
+                !points
+                    .iter()
+                    .flatten()
+                    .any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e))
             })
         })
         .collect()
@@ -99,14 +100,13 @@ fn draw(path: &Path, title: &str, outcomes: &[Outcome]) -> Result<(), String> {
         .y_label_formatter(&|v| format!("{v:.1e}"))
         .draw()
         .map_err(|e| e.to_string())?;
-    let mut on_front: Vec<(f64, f64)> = points
-        .iter()
-        .filter(|p| p.3)
-        .map(|p| (p.0, p.1))
-        .collect();
+    let mut on_front: Vec<(f64, f64)> = points.iter().filter(|p| p.3).map(|p| (p.0, p.1)).collect();
     on_front.sort_by(|a, b| a.0.total_cmp(&b.0));
     chart
-        .draw_series(LineSeries::new(on_front.iter().copied(), RED.stroke_width(2)))
+        .draw_series(LineSeries::new(
+            on_front.iter().copied(),
+            RED.stroke_width(2),
+        ))
         .map_err(|e| e.to_string())?
         .label("Pareto front")
         .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
@@ -120,9 +120,9 @@ fn draw(path: &Path, title: &str, outcomes: &[Outcome]) -> Result<(), String> {
         .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
     chart
         .draw_series(
-            points
-                .iter()
-                .map(|&(t, e, label, _)| Text::new(format!("  {label}"), (t, e), ("sans-serif", 12))),
+            points.iter().map(|&(t, e, label, _)| {
+                Text::new(format!("  {label}"), (t, e), ("sans-serif", 12))
+            }),
         )
         .map_err(|e| e.to_string())?;
     chart
@@ -157,11 +157,15 @@ pub fn table(outcomes: &[Outcome]) -> String {
             number(o.seconds, 3),
             o.steps.map_or("-".into(), |s| s.to_string()),
             o.ppe_iterations.map_or("-".into(), |p| format!("{p:.1}")),
-            o.peak_bytes.map_or("-".into(), |b| format!("{:.1}", b / 1e6)),
+            o.peak_bytes
+                .map_or("-".into(), |b| format!("{:.1}", b / 1e6)),
             o.label,
             o.status
         );
     }
-    let _ = writeln!(t, "* on the Pareto front: no other point has both a smaller error and a shorter wall time");
+    let _ = writeln!(
+        t,
+        "* on the Pareto front: no other point has both a smaller error and a shorter wall time"
+    );
     t
 }

@@ -51,8 +51,7 @@ pub fn append(path: &Path, fields: &[String]) -> Result<(), StudyError> {
         .append(true)
         .open(path)
         .map_err(write_error)?;
-    file.write_all(line(fields).as_bytes())
-        .map_err(write_error)
+    file.write_all(line(fields).as_bytes()).map_err(write_error)
 }
 
 /// The complete rows of `path`, each a map from column name to field.
