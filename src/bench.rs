@@ -2,12 +2,13 @@
 //! counts and thread counts (issue 4).
 //!
 //! Each (size, threads) point runs in a child process of its own (the hidden `--child` form of
-//! `isph bench`), so that the peak resident memory it reports (VmHWM) is that point's alone and
-//! its thread pool has exactly the requested size. The child builds the scene, takes warm-up
+//! `isph bench`, see [`crate::child`]), so that the peak resident memory it reports (VmHWM) is
+//! that point's alone and its thread pool has exactly the requested size. The child builds the scene, takes warm-up
 //! steps, times the steps that follow through the public `Simulation` API, then times the PPE
 //! operator's apply on the state reached (see [`PpeSetup`]) and prints a [`Measurement`] as TOML
 //! on stdout; the parent collects the points, prints a table and writes the CSV.
 
+use crate::child::{self, peak_resident_bytes, ChildError};
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::linsolve::LinearOperator;
@@ -56,28 +57,14 @@ pub enum BenchError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("cannot start {} to measure {requested} particles on {threads} threads: {source}", exe.display())]
-    Spawn {
-        exe: PathBuf,
+    #[error("measuring {requested} particles on {threads} threads: {source}")]
+    Point {
         requested: usize,
         threads: usize,
-        source: std::io::Error,
+        source: ChildError,
     },
-    #[error("measuring {requested} particles on {threads} threads failed ({status}): {message}")]
-    Child {
-        requested: usize,
-        threads: usize,
-        status: String,
-        message: String,
-    },
-    #[error("the measurement of {requested} particles on {threads} threads came back unreadable: {message}")]
-    ChildOutput {
-        requested: usize,
-        threads: usize,
-        message: String,
-    },
-    #[error("cannot read the peak resident memory (VmHWM) from /proc/self/status: {message}")]
-    Memory { message: String },
+    #[error(transparent)]
+    Process(#[from] ChildError),
     #[error(transparent)]
     Scene(#[from] SceneError),
     #[error(transparent)]
@@ -229,22 +216,6 @@ impl Measurement {
     pub fn to_toml(&self) -> String {
         toml::to_string(self).expect("a Measurement is plain numbers and lists")
     }
-}
-
-/// The peak resident set size of this process so far (VmHWM).
-fn peak_resident_bytes() -> Result<u64, BenchError> {
-    let status = std::fs::read_to_string("/proc/self/status").map_err(|e| BenchError::Memory {
-        message: e.to_string(),
-    })?;
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().strip_suffix("kB"))
-        .and_then(|v| v.trim().parse::<u64>().ok())
-        .map(|kib| kib * 1024)
-        .ok_or_else(|| BenchError::Memory {
-            message: "no `VmHWM: … kB` line".into(),
-        })
 }
 
 /// Times the PPE operator's apply on the particles' state: (pairs per apply, seconds of each
@@ -631,50 +602,19 @@ fn run_child(
     threads: usize,
     schedule: Schedule,
 ) -> Result<Measurement, BenchError> {
-    let output = Command::new(exe)
-        .args(["bench", "--child"])
-        .args(["--sizes", &requested.to_string()])
-        .args(["--threads", &threads.to_string()])
-        .args(["--steps", &schedule.steps.to_string()])
-        .args(["--warmup", &schedule.warmup.to_string()])
-        .output()
-        .map_err(|source| BenchError::Spawn {
-            exe: exe.to_owned(),
-            requested,
-            threads,
-            source,
-        })?;
-    if !output.status.success() {
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        let message = stderr.trim().trim_start_matches("error: ").to_owned();
-        return Err(BenchError::Child {
-            requested,
-            threads,
-            status: describe_exit(output.status),
-            message: if message.is_empty() {
-                "no message".into()
-            } else {
-                message
-            },
-        });
-    }
-    let text = String::from_utf8_lossy(&output.stdout);
-    toml::from_str(&text).map_err(|e| BenchError::ChildOutput {
+    child::run(
+        Command::new(exe)
+            .args(["bench", "--child"])
+            .args(["--sizes", &requested.to_string()])
+            .args(["--threads", &threads.to_string()])
+            .args(["--steps", &schedule.steps.to_string()])
+            .args(["--warmup", &schedule.warmup.to_string()]),
+    )
+    .map_err(|source| BenchError::Point {
         requested,
         threads,
-        message: e.to_string(),
+        source,
     })
-}
-
-fn describe_exit(status: std::process::ExitStatus) -> String {
-    use std::os::unix::process::ExitStatusExt;
-    match (status.code(), status.signal()) {
-        (Some(code), _) => format!("exit code {code}"),
-        // SIGKILL is what the kernel's out-of-memory killer sends.
-        (None, Some(9)) => "killed by signal 9, perhaps out of memory".into(),
-        (None, Some(s)) => format!("killed by signal {s}"),
-        (None, None) => "ended abnormally".into(),
-    }
 }
 
 /// The human table of the rows: one line per point, then the time per stage.

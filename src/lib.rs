@@ -5,6 +5,7 @@
 //! and checkpoints, and continues one from a checkpoint ([`resume`]).
 
 pub mod bench;
+pub mod child;
 pub mod free_surface;
 pub mod grid;
 pub mod io;
@@ -26,6 +27,8 @@ pub mod shifting;
 pub mod simulation;
 pub mod sph;
 pub mod step;
+pub mod study;
 pub mod timings;
 pub mod turbulence;
+pub mod validation;
 pub mod wall;

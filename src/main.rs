@@ -3,10 +3,12 @@
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand};
 use isph::bench::{self, BenchOptions, Schedule};
+use isph::child::RunReport;
 use isph::plan::Plan;
 use isph::resume::{self, ResumeOptions};
 use isph::run::{run, RunError, RunOptions, StopSignal};
 use isph::scene::Scene;
+use isph::study::{plot, StudyOptions};
 use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::flag;
 use std::path::PathBuf;
@@ -45,6 +47,10 @@ enum Command {
         /// No progress display.
         #[arg(long, short)]
         quiet: bool,
+        /// Print only what this process measured of itself (peak memory), as TOML: how
+        /// `isph study` runs each point.
+        #[arg(long, hide = true)]
+        report: bool,
     },
     /// Continue a run from a checkpoint, in the run's output directory.
     Resume {
@@ -69,6 +75,19 @@ enum Command {
     },
     /// Print the stages, particle counts and memory of a scene without running it.
     Plan { scene: PathBuf },
+    /// Run a scene over a grid of settings, measure each run's error against a reference and
+    /// plot error against wall time with its Pareto front (docs/study-format.md). Resumable:
+    /// points already in OUT/study.csv are not run again.
+    Study {
+        /// Study file (TOML).
+        study: PathBuf,
+        /// Output directory [default: out/study-<study file name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Worker threads of each run [default: all cores].
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Time the 3D dam break of scenes/dam_break_3d.toml at several particle counts and thread
     /// counts: time per step by stage, PPE iterations, pair throughput, peak memory, parallel
     /// efficiency (docs/performance.md). Each point runs in a process of its own.
@@ -134,6 +153,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             threads,
             overwrite,
             quiet,
+            report,
         } => {
             start_threads(threads)?;
             check_until(until)?;
@@ -150,6 +170,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                     stop,
                 },
             )?;
+            if report {
+                print!("{}", RunReport::of_this_process()?.to_toml());
+                return Ok(());
+            }
             println!(
                 "{}: {} steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in {}, checkpoint {}",
                 scene.name,
@@ -207,6 +231,33 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Plan { scene } => {
             let scene = Scene::load(&scene)?;
             println!("{}", Plan::new(&scene)?);
+            Ok(())
+        }
+        Command::Study {
+            study,
+            out,
+            threads,
+        } => {
+            if threads == Some(0) {
+                bail!("--threads must be at least 1");
+            }
+            let exe = std::env::current_exe().context("locating the isph executable")?;
+            let opts = StudyOptions { out, threads };
+            let summary = isph::study::run(&study, &opts, &exe, |line| eprintln!("{line}"))?;
+            print!("{}", plot::table(&summary.outcomes));
+            if summary.complete {
+                println!(
+                    "written: {} and {}",
+                    summary.csv().display(),
+                    summary.svg().display()
+                );
+            } else {
+                println!(
+                    "{} of the study's points are done (the others are being run by another isph study); {} is written when all are",
+                    summary.outcomes.len(),
+                    summary.svg().display()
+                );
+            }
             Ok(())
         }
         Command::Bench {

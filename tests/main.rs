@@ -16,4 +16,6 @@ mod neighbours;
 mod operators;
 mod output_readers;
 mod stability;
+mod study;
+mod validation;
 mod wall_contact;

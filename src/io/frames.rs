@@ -197,3 +197,74 @@ impl FrameWriter {
         self.file.flush()
     }
 }
+
+/// One frame read back from particles.h5, rows in id order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub time: f64,
+    /// (x, y, z) of each particle; z = 0 in 2D.
+    pub position: Vec<[f64; 3]>,
+    pub velocity: Vec<[f64; 3]>,
+    pub pressure: Vec<f64>,
+    /// 0 fluid, 1 wall (`particles::Kind` codes).
+    pub kind: Vec<i32>,
+}
+
+/// Reads the frames of a finished (or running) run's particles.h5.
+pub struct FrameReader {
+    file: hdf5::File,
+    path: PathBuf,
+}
+
+impl FrameReader {
+    pub fn open(dir: &Path) -> Result<Self, OutputError> {
+        let path = dir.join(FILE_NAME);
+        let file = hdf5::File::open(&path).map_err(|source| OutputError::Hdf5Read {
+            path: path.clone(),
+            source,
+        })?;
+        Ok(Self { file, path })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn error(&self, source: hdf5::Error) -> OutputError {
+        OutputError::Hdf5Read {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    /// The time of every frame, in frame order.
+    pub fn times(&self) -> Result<Vec<f64>, OutputError> {
+        let names = self.file.member_names().map_err(|e| self.error(e))?;
+        let count = names.iter().filter(|n| frame_index(n).is_some()).count();
+        (0..count)
+            .map(|k| {
+                let read = || self.file.group(&group_name(k))?.attr("time")?.read_scalar();
+                read().map_err(|e| self.error(e))
+            })
+            .collect()
+    }
+
+    /// Frame number `index`.
+    pub fn read(&self, index: usize) -> Result<Frame, OutputError> {
+        let read = || -> hdf5::Result<Frame> {
+            let g = self.file.group(&group_name(index))?;
+            let triples = |name: &str| -> hdf5::Result<Vec<[f64; 3]>> {
+                let flat = g.dataset(name)?.read_raw::<f64>()?;
+                Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+            };
+            Ok(Frame {
+                time: g.attr("time")?.read_scalar()?,
+                position: triples("position")?,
+                velocity: triples("velocity")?,
+                pressure: g.dataset("pressure")?.read_raw()?,
+                kind: g.dataset("kind")?.read_raw()?,
+            })
+        };
+        read().map_err(|e| self.error(e))
+    }
+}

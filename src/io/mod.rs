@@ -34,6 +34,8 @@ pub enum OutputError {
     Hdf5Read { path: PathBuf, source: hdf5::Error },
     #[error("{path} does not belong with the checkpoint: {what}")]
     Mismatch { path: PathBuf, what: String },
+    #[error("{path}: {what}")]
+    Malformed { path: PathBuf, what: String },
 }
 
 /// Files that make a directory an isph run.

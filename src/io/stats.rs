@@ -138,3 +138,31 @@ pub fn end_of_step(dir: &Path, step: u64) -> Result<u64, OutputError> {
         "it has no row for the checkpoint's step {step} (its last complete row is step {last})"
     )))
 }
+
+/// Column `name` of the stats.csv of `dir`, one value per step.
+pub fn read_column(dir: &Path, name: &str) -> Result<Vec<f64>, OutputError> {
+    let path = dir.join(FILE_NAME);
+    let text = std::fs::read_to_string(&path).map_err(|source| OutputError::Read {
+        path: path.clone(),
+        source,
+    })?;
+    let mismatch = |what: String| OutputError::Malformed {
+        path: path.clone(),
+        what,
+    };
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default();
+    let col = header
+        .split(',')
+        .position(|c| c == name)
+        .ok_or_else(|| mismatch(format!("its header `{header}` has no column `{name}`")))?;
+    lines
+        .enumerate()
+        .map(|(k, line)| {
+            line.split(',')
+                .nth(col)
+                .and_then(|v| v.parse::<f64>().ok())
+                .ok_or_else(|| mismatch(format!("row {} has no number in `{name}`", k + 1)))
+        })
+        .collect()
+}

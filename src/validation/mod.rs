@@ -1,0 +1,153 @@
+//! Error measures of a finished run against a reference solution or experiment, computed from
+//! the run's `particles.h5` and `stats.csv`: what `isph study` plots against wall time and what
+//! the validation tests assert. One file per case.
+
+pub mod dam_break;
+pub mod hydrostatic;
+
+use crate::io::frames::{Frame, FrameReader};
+use crate::io::OutputError;
+use crate::particles::Kind;
+use crate::scene::Scene;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// A reference the error of a run is measured against.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Case {
+    /// Still water: the pressure against ρ0 |g| (H − y) (`hydrostatic.rs`).
+    Hydrostatic,
+    /// Collapsing 2:1 column: the surge front against Martin & Moyce (1952) (`dam_break.rs`).
+    DamBreakFront,
+}
+
+impl Case {
+    pub const ALL: [Case; 2] = [Case::Hydrostatic, Case::DamBreakFront];
+
+    /// The name a study file gives (`measure = "…"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Case::Hydrostatic => "hydrostatic",
+            Case::DamBreakFront => "dam_break_front",
+        }
+    }
+
+    /// The names of the details `measure` returns for this case, in their order.
+    pub fn detail_names(self) -> &'static [&'static str] {
+        match self {
+            Case::Hydrostatic => &hydrostatic::DETAILS,
+            Case::DamBreakFront => &dam_break::DETAILS,
+        }
+    }
+}
+
+impl std::fmt::Display for Case {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A name that is no `Case`.
+#[derive(Debug, thiserror::Error)]
+#[error("\"{name}\" is no error measure; known: {}", Case::ALL.map(|c| format!("\"{c}\"")).join(", "))]
+pub struct UnknownCase {
+    pub name: String,
+}
+
+impl FromStr for Case {
+    type Err = UnknownCase;
+
+    fn from_str(name: &str) -> Result<Self, Self::Err> {
+        Case::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| UnknownCase { name: name.into() })
+    }
+}
+
+/// What `measure` found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measured {
+    /// The headline relative error of the case.
+    pub error: f64,
+    /// Named extras, in the order of `Case::detail_names`.
+    pub details: Vec<(String, f64)>,
+}
+
+impl Measured {
+    fn new(error: f64, names: &[&str], values: &[f64]) -> Self {
+        let details = names
+            .iter()
+            .zip(values)
+            .map(|(n, &v)| (n.to_string(), v))
+            .collect();
+        Self { error, details }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ValidationError {
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error("{case}: the scene {}: {message}", path.display())]
+    Scene {
+        case: Case,
+        path: PathBuf,
+        message: String,
+    },
+    #[error("{case}: the run in {}: {message}", dir.display())]
+    Run {
+        case: Case,
+        dir: PathBuf,
+        message: String,
+    },
+}
+
+/// The error of the finished run of `scene` in `run_dir` against `case`.
+pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
+    match case {
+        Case::Hydrostatic => hydrostatic::measure(scene, run_dir),
+        Case::DamBreakFront => dam_break::measure(scene, run_dir),
+    }
+}
+
+/// The axis gravity points down along (it must be along one axis only) and |g|.
+fn vertical(case: Case, scene: &Scene) -> Result<(usize, f64), ValidationError> {
+    let along: Vec<usize> = (0..scene.gravity.len())
+        .filter(|&d| scene.gravity[d] != 0.0)
+        .collect();
+    match along[..] {
+        [v] if scene.gravity[v] < 0.0 => Ok((v, -scene.gravity[v])),
+        _ => Err(ValidationError::Scene {
+            case,
+            path: scene.path.clone(),
+            message: format!(
+                "gravity {:?} must point down one axis (e.g. [0.0, -9.81])",
+                scene.gravity
+            ),
+        }),
+    }
+}
+
+/// The last frame of the run in `run_dir`.
+fn last_frame(case: Case, run_dir: &Path) -> Result<Frame, ValidationError> {
+    let reader = FrameReader::open(run_dir)?;
+    let count = reader.times()?.len();
+    if count == 0 {
+        return Err(no_frames(case, run_dir));
+    }
+    Ok(reader.read(count - 1)?)
+}
+
+fn no_frames(case: Case, run_dir: &Path) -> ValidationError {
+    ValidationError::Run {
+        case,
+        dir: run_dir.to_owned(),
+        message: "its particles.h5 holds no frame".into(),
+    }
+}
+
+/// The rows of `frame` that are fluid particles.
+fn fluid(frame: &Frame) -> impl Iterator<Item = usize> + '_ {
+    (0..frame.kind.len()).filter(|&i| frame.kind[i] == Kind::Fluid as i32)
+}

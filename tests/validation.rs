@@ -1,0 +1,122 @@
+//! The pure parts of the error measures (`isph::validation`): synthetic fronts, frames and
+//! columns with known answers.
+
+use isph::io::frames::Frame;
+use isph::validation::dam_break::{pick_frames, relative_errors, Column, MARTIN_MOYCE_FRONT};
+use isph::validation::hydrostatic::WaterColumn;
+use isph::validation::Case;
+
+/// A frame of fluid particles (kind 0) at `points` (x, y), plus one wall particle far away.
+fn frame(points: &[(f64, f64)]) -> Frame {
+    let mut position: Vec<[f64; 3]> = points.iter().map(|&(x, y)| [x, y, 0.0]).collect();
+    position.push([100.0, 100.0, 0.0]);
+    let n = position.len();
+    let mut kind = vec![0; n];
+    kind[n - 1] = 1;
+    Frame {
+        time: 0.0,
+        position,
+        velocity: vec![[0.0; 3]; n],
+        pressure: vec![0.0; n],
+        kind,
+    }
+}
+
+fn column() -> Column {
+    Column {
+        vertical: 1,
+        back: -0.5,
+        width: 2.0,
+        height: 4.0,
+        floor: 1.0,
+        time_scale: 1.0,
+        far_wall: 20.0,
+    }
+}
+
+#[test]
+fn case_names_round_trip_and_unknown_names_are_listed() {
+    for case in Case::ALL {
+        assert_eq!(case.name().parse::<Case>().unwrap(), case);
+    }
+    let e = "poiseuille".parse::<Case>().unwrap_err().to_string();
+    assert!(e.contains("\"hydrostatic\", \"dam_break_front\""), "{e}");
+}
+
+#[test]
+fn front_and_column_height_ignore_walls_and_count_from_the_back_wall() {
+    let c = column();
+    // Fronts at x = 3.5 (4 from the back wall: Z = 2); near the wall (x − back < a/4 = 0.5)
+    // the highest particle is at y = 3 (2 above the floor: half the initial height).
+    let f = frame(&[(-0.4, 3.0), (0.2, 4.5), (3.5, 1.1), (1.0, 1.5)]);
+    assert_eq!(c.front(&f), 2.0);
+    assert_eq!(c.height_at_wall(&f), 0.5);
+}
+
+#[test]
+fn a_front_on_the_tabulated_curve_has_no_error_and_a_late_one_its_lag() {
+    let times: Vec<f64> = (0..=45).map(|k| 0.1 * k as f64).collect();
+    let picks = pick_frames(&times, &MARTIN_MOYCE_FRONT).unwrap();
+    // Reached: the points up to T = 4.418 (within MAX_GAP of the last frame, 4.5).
+    assert_eq!(picks.len(), 7);
+    for &(k, f) in &picks {
+        assert!((times[f] - MARTIN_MOYCE_FRONT[k].0).abs() <= 0.05 + 1e-12);
+    }
+    let exact: Vec<(f64, f64)> = MARTIN_MOYCE_FRONT.iter().map(|&(_, z)| (z, z)).collect();
+    assert!(relative_errors(&exact).iter().all(|&e| e == 0.0));
+    let ahead: Vec<(f64, f64)> = MARTIN_MOYCE_FRONT
+        .iter()
+        .map(|&(_, z)| (1.1 * z, z))
+        .collect();
+    assert!(relative_errors(&ahead)
+        .iter()
+        .all(|&e| (e - 0.1).abs() < 1e-12));
+}
+
+#[test]
+fn sparse_frames_are_refused_and_a_short_run_compares_nothing() {
+    let sparse: Vec<f64> = (0..=10).map(|k| 0.5 * k as f64).collect();
+    let gap = pick_frames(&sparse, &MARTIN_MOYCE_FRONT).unwrap_err();
+    assert_eq!(gap.t_ref, 0.832);
+    assert_eq!(gap.nearest, 1.0);
+    assert!(pick_frames(&[0.0, 0.1, 0.2], &MARTIN_MOYCE_FRONT)
+        .unwrap()
+        .is_empty());
+}
+
+#[test]
+fn the_container_bounds_the_points_compared() {
+    // A far wall 7 widths away (dam_break_2d.toml): fronts up to Z = 6.3.
+    let c = Column {
+        far_wall: 7.0,
+        ..column()
+    };
+    let reference = c.reference();
+    assert_eq!(reference.len(), 7);
+    assert!(reference.iter().all(|&(_, z)| z <= 6.3));
+}
+
+#[test]
+fn hydrostatic_errors_of_an_exact_and_a_shifted_column() {
+    let c = WaterColumn {
+        rho_g: 1000.0 * 9.81,
+        floor: 0.0,
+        top: 1.0,
+    };
+    let exact: Vec<(f64, f64)> = (0..20)
+        .map(|k| {
+            let y = 0.025 + 0.05 * k as f64;
+            (y, c.rho_g * (1.0 - y))
+        })
+        .collect();
+    assert!(c.rms_error(&exact).unwrap() < 1e-12);
+    assert!(c.bottom_error(&exact, 0.05).unwrap().abs() < 1e-12);
+    // 1% of ρgH too much everywhere, the surface layer (top 15%) excepted from the rms.
+    let high: Vec<(f64, f64)> = exact
+        .iter()
+        .map(|&(y, p)| (y, p + 0.01 * c.floor_pressure()))
+        .collect();
+    assert!((c.rms_error(&high).unwrap() - 0.01).abs() < 1e-12);
+    assert!((c.bottom_error(&high, 0.05).unwrap() - 0.01).abs() < 1e-12);
+    assert!(c.rms_error(&[(0.95, 0.0)]).is_none());
+}
