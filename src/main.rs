@@ -88,6 +88,16 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Measure the error of a finished run against a reference solution or experiment
+    /// (the error measures of `isph study`, docs/study-format.md).
+    Measure {
+        /// The error measure: hydrostatic, dam_break_front, poiseuille or taylor_green.
+        measure: String,
+        /// The scene the run was made from.
+        scene: PathBuf,
+        /// The run's output directory.
+        run: PathBuf,
+    },
     /// Time the 3D dam break of scenes/dam_break_3d.toml at several particle counts and thread
     /// counts: time per step by stage, PPE iterations, pair throughput, peak memory, parallel
     /// efficiency (docs/performance.md). Each point runs in a process of its own.
@@ -231,6 +241,20 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Plan { scene } => {
             let scene = Scene::load(&scene)?;
             println!("{}", Plan::new(&scene)?);
+            Ok(())
+        }
+        Command::Measure {
+            measure,
+            scene,
+            run,
+        } => {
+            let case: isph::validation::Case = measure.parse()?;
+            let scene = Scene::load(&scene)?;
+            let measured = isph::validation::measure(case, &scene, &run)?;
+            println!("error = {:e}", measured.error);
+            for (name, value) in &measured.details {
+                println!("{name} = {value:e}");
+            }
             Ok(())
         }
         Command::Study {

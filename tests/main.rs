@@ -15,6 +15,7 @@ mod linsolve;
 mod neighbours;
 mod operators;
 mod output_readers;
+mod periodic_flows;
 mod stability;
 mod study;
 mod validation;

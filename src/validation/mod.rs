@@ -4,6 +4,8 @@
 
 pub mod dam_break;
 pub mod hydrostatic;
+pub mod poiseuille;
+pub mod taylor_green;
 
 use crate::io::frames::{Frame, FrameReader};
 use crate::io::OutputError;
@@ -19,16 +21,27 @@ pub enum Case {
     Hydrostatic,
     /// Collapsing 2:1 column: the surge front against Martin & Moyce (1952) (`dam_break.rs`).
     DamBreakFront,
+    /// Start-up flow between plates against the analytic series (`poiseuille.rs`).
+    Poiseuille,
+    /// The decaying Taylor–Green vortex (`taylor_green.rs`).
+    TaylorGreen,
 }
 
 impl Case {
-    pub const ALL: [Case; 2] = [Case::Hydrostatic, Case::DamBreakFront];
+    pub const ALL: [Case; 4] = [
+        Case::Hydrostatic,
+        Case::DamBreakFront,
+        Case::Poiseuille,
+        Case::TaylorGreen,
+    ];
 
     /// The name a study file gives (`measure = "…"`).
     pub fn name(self) -> &'static str {
         match self {
             Case::Hydrostatic => "hydrostatic",
             Case::DamBreakFront => "dam_break_front",
+            Case::Poiseuille => "poiseuille",
+            Case::TaylorGreen => "taylor_green",
         }
     }
 
@@ -37,6 +50,8 @@ impl Case {
         match self {
             Case::Hydrostatic => &hydrostatic::DETAILS,
             Case::DamBreakFront => &dam_break::DETAILS,
+            Case::Poiseuille => &poiseuille::DETAILS,
+            Case::TaylorGreen => &taylor_green::DETAILS,
         }
     }
 }
@@ -108,6 +123,8 @@ pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, Va
     match case {
         Case::Hydrostatic => hydrostatic::measure(scene, run_dir),
         Case::DamBreakFront => dam_break::measure(scene, run_dir),
+        Case::Poiseuille => poiseuille::measure(scene, run_dir),
+        Case::TaylorGreen => taylor_green::measure(scene, run_dir),
     }
 }
 

@@ -1,0 +1,81 @@
+//! The 2D Taylor–Green vortex of a periodic square of side L (`[initial_velocity]
+//! field = "taylor_green"`): the exact solution decays in shape, its velocity as exp(−8π²νt/L²)
+//! and its kinetic energy as the square of that.
+//!
+//! The error is the relative error of the velocity decay rate, fitted by least squares to
+//! ½ ln E(t) of every step in stats.csv (E the kinetic energy), against 8π²ν/L². Details: that
+//! fitted rate [1/s], and the L2 error of the velocity field of the last frame against the
+//! exact field, relative to the exact field's L2 norm.
+
+use super::{fluid, last_frame, Case, Measured, ValidationError};
+use crate::io::stats::read_column;
+use crate::scene::{InitialVelocity, Scene};
+use std::f64::consts::PI;
+use std::path::Path;
+
+pub const DETAILS: [&str; 2] = ["decay_rate", "velocity_l2_error"];
+
+/// The velocity decay rate 8π²ν/L² [1/s] of the vortex of side L.
+pub fn decay_rate(viscosity: f64, side: f64) -> f64 {
+    8.0 * PI * PI * viscosity / (side * side)
+}
+
+/// The least-squares slope of y against t.
+pub fn slope(t: &[f64], y: &[f64]) -> f64 {
+    let n = t.len() as f64;
+    let (mt, my) = (t.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let cov: f64 = t.iter().zip(y).map(|(t, y)| (t - mt) * (y - my)).sum();
+    let var: f64 = t.iter().map(|t| (t - mt) * (t - mt)).sum();
+    cov / var
+}
+
+pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
+    let case = Case::TaylorGreen;
+    let scene_error = |message: &str| ValidationError::Scene {
+        case,
+        path: scene.path.clone(),
+        message: message.into(),
+    };
+    let Some(field @ InitialVelocity::TaylorGreen { .. }) = scene.initial_velocity else {
+        return Err(scene_error(
+            "has no `[initial_velocity] field = \"taylor_green\"`",
+        ));
+    };
+    let nu = scene.fluids[0].viscosity;
+    if nu <= 0.0 {
+        return Err(scene_error(
+            "has an inviscid fluid: the vortex does not decay",
+        ));
+    }
+    let rate = decay_rate(nu, scene.container.max[0] - scene.container.min[0]);
+
+    let time = read_column(run_dir, "time")?;
+    let energy = read_column(run_dir, "kinetic_energy")?;
+    if time.len() < 2 || energy.iter().any(|&e| e <= 0.0) {
+        return Err(ValidationError::Run {
+            case,
+            dir: run_dir.to_owned(),
+            message: "its stats.csv needs two steps or more, all with kinetic energy".into(),
+        });
+    }
+    let half_log: Vec<f64> = energy.iter().map(|e| 0.5 * e.ln()).collect();
+    let fitted = -slope(&time, &half_log);
+
+    // The exact field at the last frame: the initial field times exp(−rate t).
+    let frame = last_frame(case, run_dir)?;
+    let decay = (-rate * frame.time).exp();
+    let (mut error, mut norm) = (0.0, 0.0);
+    for i in fluid(&frame) {
+        let [x, y, _] = frame.position[i];
+        let exact = field.at(&scene.container, [x, y]).map(|u| u * decay);
+        let u = frame.velocity[i];
+        error += (u[0] - exact[0]).powi(2) + (u[1] - exact[1]).powi(2);
+        norm += exact[0].powi(2) + exact[1].powi(2);
+    }
+    let velocity_l2 = (error / norm).sqrt();
+    Ok(Measured::new(
+        (fitted - rate).abs() / rate,
+        &DETAILS,
+        &[fitted, velocity_l2],
+    ))
+}
