@@ -147,8 +147,8 @@ fn bad_study_files_are_refused_with_the_file_and_key_named() {
         ),
         (
             "unknown measure",
-            format!("scene = \"{scene}\"\nmeasure = \"poiseuille\"\n"),
-            &["`measure`", "\"poiseuille\" is no error measure"],
+            format!("scene = \"{scene}\"\nmeasure = \"couette\"\n"),
+            &["`measure`", "\"couette\" is no error measure"],
         ),
         (
             "grid key not in the scene",
