@@ -129,10 +129,11 @@ pub fn run(
         table::append(&csv, &row)?;
     }
     let rows = done(&csv)?;
+    let varying = varying_settings(&study.points);
     let outcomes: Vec<Outcome> = study
         .points
         .iter()
-        .filter_map(|p| rows.get(&p.id).map(|row| outcome(p, row)))
+        .filter_map(|p| rows.get(&p.id).map(|row| outcome(p, row, &varying)))
         .collect();
     let complete = outcomes.len() == total;
     let summary = Summary {
@@ -295,12 +296,35 @@ fn measure_run(
     result
 }
 
-/// A point's row of study.csv as an `Outcome`.
-fn outcome(point: &Point, row: &HashMap<String, String>) -> Outcome {
+/// The grid keys that take more than one value over the points: what tells points apart.
+fn varying_settings(points: &[Point]) -> Vec<String> {
+    let Some(first) = points.first() else {
+        return Vec::new();
+    };
+    first
+        .settings
+        .iter()
+        .filter(|(key, value)| {
+            points
+                .iter()
+                .any(|p| p.settings.iter().any(|(k, v)| k == key && v != value))
+        })
+        .map(|(key, _)| key.clone())
+        .collect()
+}
+
+/// A point's row of study.csv as an `Outcome`, labelled by its `varying` settings.
+fn outcome(point: &Point, row: &HashMap<String, String>, varying: &[String]) -> Outcome {
     let number = |name: &str| row.get(name).and_then(|v| v.parse::<f64>().ok());
+    let settings: Vec<_> = point
+        .settings
+        .iter()
+        .filter(|(k, _)| varying.contains(k))
+        .cloned()
+        .collect();
     Outcome {
         id: point.id.clone(),
-        label: label(&point.settings),
+        label: label(&settings),
         error: number("error"),
         seconds: number("wall_seconds"),
         steps: number("steps"),

@@ -3,6 +3,7 @@
 
 use super::StudyError;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -47,8 +48,8 @@ pub fn pareto(outcomes: &[Outcome]) -> Vec<bool> {
         .collect()
 }
 
-/// The log-log plot of error against wall time, every plotted outcome labelled, the front
-/// marked and connected, written atomically to `path`.
+/// The log-log plot of error against wall time, the front marked, connected and labelled,
+/// written atomically to `path`.
 pub fn write_svg(path: &Path, title: &str, outcomes: &[Outcome]) -> Result<(), StudyError> {
     let private = path.with_extension(format!("svg.new-{}", std::process::id()));
     draw(&private, title, outcomes).map_err(|message| StudyError::Plot {
@@ -116,17 +117,28 @@ fn draw(path: &Path, title: &str, outcomes: &[Outcome]) -> Result<(), String> {
             Circle::new((t, e), if f { 6 } else { 4 }, colour.filled())
         }))
         .map_err(|e| e.to_string())?
-        .label("point")
+        .label("other points (study.csv)")
         .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
+    // The front's points are labelled with their settings (the others are in study.csv), on
+    // the side of the point away from the plot's right edge.
+    let x_range = log_range(points.iter().map(|p| p.0));
+    let middle = (x_range.start * x_range.end).sqrt();
     chart
-        .draw_series(
-            points.iter().map(|&(t, e, label, _)| {
-                Text::new(format!("  {label}"), (t, e), ("sans-serif", 12))
-            }),
-        )
+        .draw_series(points.iter().filter(|p| p.3).map(|&(t, e, label, _)| {
+            let (text, anchor) = if t < middle {
+                (format!("  {label}"), HPos::Left)
+            } else {
+                (format!("{label}  "), HPos::Right)
+            };
+            let style =
+                TextStyle::from(("sans-serif", 12).into_font()).pos(Pos::new(anchor, VPos::Center));
+            Text::new(text, (t, e), style)
+        }))
         .map_err(|e| e.to_string())?;
+    // Nothing is below and left of the front: the legend goes there.
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
         .border_style(BLACK)
         .background_style(WHITE)
         .draw()

@@ -41,6 +41,9 @@ pub const MARTIN_MOYCE_FRONT: [(f64, f64); 15] = [
 /// little room for the rounding of frame times.
 pub const MAX_GAP: f64 = 0.051;
 
+/// Height over width of the tabulated column (n² = 2).
+const ASPECT: f64 = 2.0;
+
 /// Tabulated fronts beyond this fraction of the way to the far wall are not compared.
 const REACH: f64 = 0.9;
 
@@ -88,11 +91,17 @@ impl Column {
             )));
         }
         let width = region.max[0] - back;
+        let height = region.max[v] - region.min[v];
+        if (height / width - ASPECT).abs() > 0.02 * ASPECT {
+            return Err(unsuitable(format!(
+                "Martin & Moyce's fronts are for a column twice as high as wide; the first fluid block is {height} m high and {width} m wide (from the back wall)"
+            )));
+        }
         Ok(Self {
             vertical: v,
             back,
             width,
-            height: region.max[v] - region.min[v],
+            height,
             floor: region.min[v],
             time_scale: (2.0 * g / width).sqrt(),
             far_wall: (scene.container.max[0] - back) / width,
