@@ -63,6 +63,9 @@ struct Level<const D: usize> {
     /// Stencil rows, 3^D coefficients per cell.
     stencil: Vec<f64>,
     inv_diag: Vec<f64>,
+    /// Cells holding unknowns; the others (empty cells of the grid: air, dry walls) have the
+    /// identity row, and their right-hand side, solution and residual stay zero.
+    active: Vec<bool>,
     /// Right-hand side, solution and residual of this level.
     b: Vec<f64>,
     x: Vec<f64>,
@@ -79,6 +82,7 @@ impl<const D: usize> Level<D> {
             dims,
             stencil: vec![0.0; n * Self::WIDTH],
             inv_diag: vec![0.0; n],
+            active: vec![false; n],
             b: vec![0.0; n],
             x: vec![0.0; n],
             r: vec![0.0; n],
@@ -94,7 +98,8 @@ impl<const D: usize> Level<D> {
         let w = Self::WIDTH;
         for c in 0..self.len() {
             let row = &mut self.stencil[c * w..(c + 1) * w];
-            if row[Self::CENTRE] == 0.0 {
+            self.active[c] = row[Self::CENTRE] != 0.0;
+            if !self.active[c] {
                 row.fill(0.0);
                 row[Self::CENTRE] = 1.0;
             }
@@ -102,11 +107,15 @@ impl<const D: usize> Level<D> {
         }
     }
 
-    /// r = b − A x on this level.
+    /// r = b − A x on this level (b − x for the identity rows of inactive cells).
     fn residual(&mut self) {
         let w = Self::WIDTH;
         let (stencil, x, b, dims) = (&self.stencil, &self.x, &self.b, self.dims);
+        let active = &self.active;
         fill(&mut self.r, |c| {
+            if !active[c] {
+                return b[c] - x[c];
+            }
             let row = &stencil[c * w..(c + 1) * w];
             let mut s = b[c];
             for_each_offset::<D>(|slot, offset| {
@@ -120,12 +129,12 @@ impl<const D: usize> Level<D> {
         });
     }
 
-    /// The next coarser level: 2^D cells merged, A_c = Pᵀ A P.
+    /// The next coarser level: 2^D cells merged, A_c = Pᵀ A P over the active cells.
     fn coarsen(&self) -> Level<D> {
         let dims = self.dims.map(|n| n.div_ceil(2));
         let mut coarse = Level::new(dims);
         let w = Self::WIDTH;
-        for c in 0..self.len() {
+        for c in (0..self.len()).filter(|&c| self.active[c]) {
             let parent = parent_cell(self.dims, dims, c);
             let row = &self.stencil[c * w..(c + 1) * w];
             for_each_offset::<D>(|slot, offset| {
