@@ -61,9 +61,9 @@ impl<const D: usize> CellList<D> {
 
     /// Moves every position along a periodic axis back into its period [lo, lo + L).
     pub fn wrap(&self, pos: &mut [Vec<f64>; D]) {
-        for d in 0..D {
-            if let Some((lo, length)) = self.period[d] {
-                pos[d].par_iter_mut().for_each(|x| {
+        for (axis, period) in pos.iter_mut().zip(self.period) {
+            if let Some((lo, length)) = period {
+                axis.par_iter_mut().for_each(|x| {
                     if *x < lo || *x >= lo + length {
                         let r = (*x - lo).rem_euclid(length);
                         // rem_euclid of a tiny negative number rounds up to the length itself.

@@ -55,8 +55,8 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     if let Some(field) = &scene.initial_velocity {
         for i in 0..particles.len() {
             let u = field.at(&scene.container, particles.position(i));
-            for d in 0..D {
-                particles.vel[d][i] = u[d];
+            for (axis, u) in particles.vel.iter_mut().zip(u) {
+                axis[i] = u;
             }
         }
     }
