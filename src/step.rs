@@ -102,8 +102,9 @@ pub struct Workspace<const D: usize> {
     pressure: Vec<f64>,
     bicgstab: BiCgStab,
     multigrid: Multigrid<D>,
-    /// Normal of the wall each fluid particle touches (zero: none).
-    contact: [Vec<f64>; D],
+    /// The wall particle each fluid particle touches (`wall::contact`; its normal is the
+    /// wall's).
+    contact: Vec<u32>,
     /// The number of fluid particles up to each index (the wall pressure's dry-wall test).
     fluid_through: Vec<u32>,
     velocity: [Vec<f64>; D],
@@ -130,7 +131,7 @@ impl<const D: usize> Default for Workspace<D> {
             pressure: Vec::new(),
             bicgstab: BiCgStab::default(),
             multigrid: Multigrid::default(),
-            contact: components(),
+            contact: Vec::new(),
             fluid_through: Vec::new(),
             velocity: components(),
             shift: components(),
@@ -266,10 +267,7 @@ impl<const D: usize> Workspace<D> {
             ),
             (Stage::PressureSolve, ArraySize::of("right-hand side", rhs)),
             (Stage::PressureSolve, ArraySize::of("pressure", pressure)),
-            (
-                Stage::Corrector,
-                ArraySize::of_components("contact normal", contact),
-            ),
+            (Stage::Corrector, ArraySize::of("contact wall", contact)),
             (
                 Stage::Corrector,
                 ArraySize::of_components("velocity", velocity),
@@ -465,12 +463,13 @@ impl<const D: usize> Workspace<D> {
     /// Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls
     /// as ghosts; particles touching a wall keep no velocity into it (`wall::no_penetration`).
     fn correct(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
-        for a in self.contact.iter_mut().chain(&mut self.velocity) {
+        for a in &mut self.velocity {
             a.resize(p.len(), 0.0);
         }
-        fill_vector(&mut self.contact, |i| match p.kind[i] {
-            Kind::Fluid => wall::contact_normal(nb, p, set.spacing, i),
-            Kind::Wall => [0.0; D],
+        self.contact.resize(p.len(), wall::NO_CONTACT);
+        fill(&mut self.contact, |i| match p.kind[i] {
+            Kind::Fluid => wall::contact(nb, p, set.spacing, i),
+            Kind::Wall => wall::NO_CONTACT,
         });
         let (u_star, contact) = (&self.u_star, &self.contact);
         let corrections =
@@ -480,7 +479,7 @@ impl<const D: usize> Workspace<D> {
                 let grad = pressure_gradient(nb, p, set.gravity, corrections.of(i), i);
                 let rho0 = p.rest_density[i];
                 let u = std::array::from_fn(|d| u_star[d][i] - dt * grad[d] / rho0);
-                wall::no_penetration(u, vector(contact, i))
+                wall::no_penetration(u, wall::contact_normal(p, contact[i]))
             }
             Kind::Wall => [0.0; D],
         });
@@ -575,7 +574,7 @@ impl<const D: usize> Workspace<D> {
             // there.
             Role::Interior | Role::Surface | Role::Reference => {
                 let dr = shifting.displacement(nb, p, &supports[i], full[i], i);
-                wall::no_penetration(dr, vector(contact, i))
+                wall::no_penetration(dr, wall::contact_normal(p, contact[i]))
             }
             Role::Splash | Role::Wall => [0.0; D],
         });

@@ -118,15 +118,27 @@ pub fn face_distance<const D: usize>(
     Some(((dot(r_ib, n) - 0.5 * spacing).max(0.25 * spacing), n))
 }
 
-/// The wall a fluid particle touches: the normal of the nearest wall particle closer than the
-/// spacing dx (nearer than at rest), or zero where there is none.
-pub fn contact_normal<const D: usize>(
+/// `contact` of a particle touching no wall.
+pub const NO_CONTACT: u32 = u32::MAX;
+
+/// The wall particle a fluid particle touches: the nearest one closer than the spacing dx
+/// (nearer than at rest), or `NO_CONTACT`.
+pub fn contact<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     spacing: f64,
     i: usize,
-) -> [f64; D] {
-    nearest_wall(nb, p, spacing, i).map_or([0.0; D], |(b, _)| p.wall_normal(b))
+) -> u32 {
+    nearest_wall(nb, p, spacing, i).map_or(NO_CONTACT, |(b, _)| b as u32)
+}
+
+/// The normal of the wall a particle touches (`contact`), zero where it touches none.
+pub fn contact_normal<const D: usize>(p: &Particles<D>, contact: u32) -> [f64; D] {
+    if contact == NO_CONTACT {
+        [0.0; D]
+    } else {
+        p.wall_normal(contact as usize)
+    }
 }
 
 /// The kinematic wall condition v·n ≥ 0 for a velocity or displacement v of a fluid particle

@@ -26,6 +26,24 @@ fn surge_front_follows_martin_and_moyce() {
     assert!(density.iter().sum::<f64>() / (density.len() as f64) < 0.01);
 }
 
+/// The coarse 2D dam break of the accuracy study (a/15, CFL 0.5) against Martin & Moyce: the
+/// front leads the experiment by 11.7% (docs/accuracy.md: the lead grows to about 13% as the
+/// spacing shrinks), so the bound is 15%; 7 of their points are compared.
+#[test]
+fn coarse_surge_front_stays_within_15_percent_of_martin_and_moyce() {
+    let mut scene = shipped_scene("dam_break_2d.toml");
+    scene.spacing = 0.00381;
+    scene.solver.cfl = 0.5;
+    let column = Column::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+    scene.output_interval = 0.1 / column.time_scale;
+    let dir = TempDir::new("dam-break-coarse");
+    run_scene(&scene, dir.path(), 0.3);
+    let m = measure(Case::DamBreakFront, &scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
+    let detail = |name: &str| m.details.iter().find(|(n, _)| n == name).unwrap().1;
+    assert_eq!(detail("front_points"), 7.0, "{m:?}");
+    assert!(m.error < 0.15, "{m:?}");
+}
+
 #[test]
 fn dam_break_3d_runs_half_a_second() {
     // The shipped column, 0.3 m wide and 0.5 m high, narrowed to Martin & Moyce's 2:1.
@@ -39,8 +57,9 @@ fn dam_break_3d_runs_half_a_second() {
     // Gravity along −z here: the front is measured along x all the same.
     let m = measure(Case::DamBreakFront, &scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
     let detail = |name: &str| m.details.iter().find(|(n, _)| n == name).unwrap().1;
+    // Measured: 4.1% (4 points; a = 0.25 m at dx = 0.04 m).
     assert!(detail("front_points") >= 4.0, "{m:?}");
-    assert!(m.error < 0.3, "{m:?}");
+    assert!(m.error < 0.1, "{m:?}");
     assert!(
         detail("column_height") > 0.1 && detail("column_height") < 1.0,
         "{m:?}"

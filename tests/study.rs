@@ -151,6 +151,11 @@ fn bad_study_files_are_refused_with_the_file_and_key_named() {
             &["`measure`", "\"couette\" is no error measure"],
         ),
         (
+            "measure that does not suit the scene",
+            format!("scene = \"{scene}\"\nmeasure = \"taylor_green\"\n"),
+            &["`measure`", "taylor_green", "initial_velocity"],
+        ),
+        (
             "grid key not in the scene",
             format!("scene = \"{scene}\"\nmeasure = \"hydrostatic\"\n[grid]\n\"simulation.spacings\" = [0.1]\n"),
             &["`grid.\"simulation.spacings\"`", "unknown field `spacings`"],

@@ -94,8 +94,11 @@ impl Study {
         let keys: Vec<String> = file.grid.keys().cloned().collect();
         let mut points = Vec::new();
         for settings in product(&file.grid) {
-            let text = scene_with(&scene_text, &scene_path, &settings)
+            let (text, scene) = scene_with(&scene_text, &scene_path, &settings)
                 .map_err(|m| invalid("grid", format!("the point {}: {m}", label(&settings))))?;
+            // A scene the measure cannot judge is refused before any point runs.
+            crate::validation::check(case, &scene)
+                .map_err(|e| invalid("measure", format!("the point {}: {e}", label(&settings))))?;
             points.push(Point {
                 id: point_id(&settings),
                 settings,
@@ -137,10 +140,11 @@ fn scene_with(
     text: &str,
     scene_path: &Path,
     settings: &[(String, toml::Value)],
-) -> Result<String, String> {
+) -> Result<(String, Scene), String> {
     let new = overrides::apply(text, settings).map_err(|e| e.to_string())?;
-    Scene::parse(&new, scene_path).map_err(|e| format!("the scene does not accept it: {e}"))?;
-    Ok(new)
+    let scene =
+        Scene::parse(&new, scene_path).map_err(|e| format!("the scene does not accept it: {e}"))?;
+    Ok((new, scene))
 }
 
 /// Every combination of the grid's values, the last key varying fastest.

@@ -128,6 +128,16 @@ pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, Va
     }
 }
 
+/// Whether `scene` suits `case`: what `measure` checks of the scene before it reads a run.
+pub fn check(case: Case, scene: &Scene) -> Result<(), ValidationError> {
+    match case {
+        Case::Hydrostatic => vertical(case, scene).map(|_| ()),
+        Case::DamBreakFront => dam_break::Column::new(scene).map(|_| ()),
+        Case::Poiseuille => poiseuille::Channel::of(scene).map(|_| ()),
+        Case::TaylorGreen => taylor_green::Vortex::of(scene).map(|_| ()),
+    }
+}
+
 /// The axis gravity points down along (it must be along one axis only) and |g|.
 fn vertical(case: Case, scene: &Scene) -> Result<(usize, f64), ValidationError> {
     let along: Vec<usize> = (0..scene.gravity.len())

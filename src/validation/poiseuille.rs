@@ -20,15 +20,37 @@ pub const DETAILS: [&str; 2] = ["max_error", "cross_velocity"];
 /// Terms of the series: the last one is below 1e-9 of the first.
 const TERMS: usize = 400;
 
-/// The channel: body force F [m/s²], width L [m], kinematic viscosity ν [m²/s].
+/// The channel: body force F [m/s²], width L [m], kinematic viscosity ν [m²/s], and the axes
+/// of the flow and across the channel.
 #[derive(Clone, Copy, Debug)]
 pub struct Channel {
     pub force: f64,
     pub width: f64,
     pub viscosity: f64,
+    pub flow: usize,
+    pub across: usize,
 }
 
 impl Channel {
+    /// The channel of `scene`: one bounded axis (the plates), every other axis periodic, and
+    /// gravity (the driving force) along one periodic axis.
+    pub fn of(scene: &Scene) -> Result<Channel, ValidationError> {
+        let Some((flow, across)) = axes(scene) else {
+            return Err(ValidationError::Scene {
+                case: Case::Poiseuille,
+                path: scene.path.clone(),
+                message: "needs one bounded axis (the plates), every other axis periodic, and gravity (the driving force) along one periodic axis".into(),
+            });
+        };
+        Ok(Channel {
+            force: scene.gravity[flow].abs(),
+            width: scene.container.max[across] - scene.container.min[across],
+            viscosity: scene.fluids[0].viscosity,
+            flow,
+            across,
+        })
+    }
+
     /// The steady centre velocity F L²/(8ν).
     pub fn max_velocity(&self) -> f64 {
         self.force * self.width * self.width / (8.0 * self.viscosity)
@@ -63,18 +85,8 @@ fn axes(scene: &Scene) -> Option<(usize, usize)> {
 
 pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
     let case = Case::Poiseuille;
-    let Some((flow, across)) = axes(scene) else {
-        return Err(ValidationError::Scene {
-            case,
-            path: scene.path.clone(),
-            message: "needs one bounded axis (the plates), every other axis periodic, and gravity (the driving force) along one periodic axis".into(),
-        });
-    };
-    let channel = Channel {
-        force: scene.gravity[flow].abs(),
-        width: scene.container.max[across] - scene.container.min[across],
-        viscosity: scene.fluids[0].viscosity,
-    };
+    let channel = Channel::of(scene)?;
+    let (flow, across) = (channel.flow, channel.across);
     let frame = last_frame(case, run_dir)?;
     let u_max = channel.max_velocity();
     let sign = scene.gravity[flow].signum();

@@ -29,25 +29,45 @@ pub fn slope(t: &[f64], y: &[f64]) -> f64 {
     cov / var
 }
 
+/// The vortex of a scene: its initial field and the exact decay rate.
+#[derive(Clone, Copy, Debug)]
+pub struct Vortex {
+    pub field: InitialVelocity,
+    /// 8π²ν/L² [1/s].
+    pub rate: f64,
+}
+
+impl Vortex {
+    /// The vortex of `scene`, which needs `[initial_velocity] field = "taylor_green"` and a
+    /// viscous fluid.
+    pub fn of(scene: &Scene) -> Result<Vortex, ValidationError> {
+        let scene_error = |message: &str| ValidationError::Scene {
+            case: Case::TaylorGreen,
+            path: scene.path.clone(),
+            message: message.into(),
+        };
+        let Some(field @ InitialVelocity::TaylorGreen { .. }) = scene.initial_velocity else {
+            return Err(scene_error(
+                "has no `[initial_velocity] field = \"taylor_green\"`",
+            ));
+        };
+        let nu = scene.fluids[0].viscosity;
+        if nu <= 0.0 {
+            return Err(scene_error(
+                "has an inviscid fluid: the vortex does not decay",
+            ));
+        }
+        let side = scene.container.max[0] - scene.container.min[0];
+        Ok(Vortex {
+            field,
+            rate: decay_rate(nu, side),
+        })
+    }
+}
+
 pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
     let case = Case::TaylorGreen;
-    let scene_error = |message: &str| ValidationError::Scene {
-        case,
-        path: scene.path.clone(),
-        message: message.into(),
-    };
-    let Some(field @ InitialVelocity::TaylorGreen { .. }) = scene.initial_velocity else {
-        return Err(scene_error(
-            "has no `[initial_velocity] field = \"taylor_green\"`",
-        ));
-    };
-    let nu = scene.fluids[0].viscosity;
-    if nu <= 0.0 {
-        return Err(scene_error(
-            "has an inviscid fluid: the vortex does not decay",
-        ));
-    }
-    let rate = decay_rate(nu, scene.container.max[0] - scene.container.min[0]);
+    let Vortex { field, rate } = Vortex::of(scene)?;
 
     let time = read_column(run_dir, "time")?;
     let energy = read_column(run_dir, "kinetic_energy")?;
