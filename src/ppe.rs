@@ -78,48 +78,50 @@ pub fn fluid_volumes<const D: usize>(p: &Particles<D>, out: &mut Vec<f64>) {
     });
 }
 
-/// Assigns roles: fluid on the free surface (see `free_surface`) takes the surface row, or P = 0
-/// where it has no consistent gradient (`gradient_defined` false: the moment matrix of its
-/// pressure gradient is near-singular, whether or not the scene applies the kernel correction).
-/// Fluid that fills its container (`confined`) has no free surface: every fluid row is
-/// interior (a disordered patch of a periodic flow can look like a surface to the detection).
+/// The role of particle i: fluid on the free surface (see `free_surface`) takes the surface
+/// row, or P = 0 where it has no consistent gradient (`gradient_defined` false: the moment
+/// matrix of its pressure gradient is near-singular, whether or not the scene applies the
+/// kernel correction). Fluid that fills its container (`confined`) has no free surface: every
+/// fluid row is interior (a disordered patch of a periodic flow can look like a surface to the
+/// detection). `support` is None for walls.
+pub fn role<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    support: Option<&Support<D>>,
+    gradient_defined: bool,
+    confined: bool,
+    i: usize,
+) -> Role {
+    let Some(support) = support else {
+        return Role::Wall;
+    };
+    if confined {
+        return Role::Interior;
+    }
+    let mut fluid_neighbours = 0;
+    nb.for_each(i, |j, _, _| fluid_neighbours += p.is_fluid(j) as usize);
+    if fluid_neighbours == 0 || !gradient_defined {
+        Role::Splash
+    } else if support.is_free_surface(nb, i, p.density[i] / p.rest_density[i]) {
+        Role::Surface
+    } else {
+        Role::Interior
+    }
+}
+
 /// If the fluid has no free surface at all (a full closed or periodic box) the PPE is singular;
 /// the highest fluid particle (the first in index order among equals) is then the reference,
 /// pinned to P = 0.
-pub fn assign_roles<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    supports: &[Support<D>],
-    gradient_defined: &[bool],
-    gravity: [f64; D],
-    confined: bool,
-    roles: &mut Vec<Role>,
-) {
-    roles.resize(p.len(), Role::Wall);
-    fill(roles, |i| match p.kind[i] {
-        Kind::Fluid if confined => Role::Interior,
-        Kind::Fluid => {
-            let mut fluid_neighbours = 0;
-            nb.for_each(i, |j, _, _| fluid_neighbours += p.is_fluid(j) as usize);
-            let free = supports[i].is_free_surface(nb, i, p.density[i] / p.rest_density[i]);
-            if fluid_neighbours == 0 || !gradient_defined[i] {
-                Role::Splash
-            } else if free {
-                Role::Surface
-            } else {
-                Role::Interior
-            }
-        }
-        Kind::Wall => Role::Wall,
-    });
-    if !roles.iter().any(|r| r.is_free()) {
-        let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
-        let top = (0..p.len())
-            .filter(|&i| roles[i] == Role::Interior)
-            .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)));
-        if let Some(top) = top {
-            roles[top] = Role::Reference;
-        }
+pub fn pin_reference<const D: usize>(p: &Particles<D>, gravity: [f64; D], roles: &mut [Role]) {
+    if roles.iter().any(|r| r.is_free()) {
+        return;
+    }
+    let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
+    let top = (0..p.len())
+        .filter(|&i| roles[i] == Role::Interior)
+        .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)));
+    if let Some(top) = top {
+        roles[top] = Role::Reference;
     }
 }
 

@@ -19,7 +19,6 @@
 //! Velocity and pressure are then carried to the shifted position by Eq. (9),
 //! φ' = φ + (∇φ)·δr.
 
-use crate::free_surface::Support;
 use crate::particles::Particles;
 use crate::sph::Neighbours;
 
@@ -70,12 +69,13 @@ impl Shifting {
     }
 
     /// δr_i of Eq. (10) for fluid particle i; `full_support` says that no free-surface particle
-    /// is in its kernel support (then the whole ∇C is used, else its tangential part).
+    /// is in its kernel support (then the whole ∇C is used, else its part tangential to the
+    /// free surface of outward normal `surface_normal`).
     pub fn displacement<const D: usize>(
         &self,
         nb: &Neighbours<D>,
         p: &Particles<D>,
-        support: &Support<D>,
+        surface_normal: [f64; D],
         full_support: bool,
         i: usize,
     ) -> [f64; D] {
@@ -90,7 +90,7 @@ impl Shifting {
             }
         });
         if !full_support {
-            let n = support.normal;
+            let n = surface_normal;
             let normal_part: f64 = (0..D).map(|d| grad_c[d] * n[d]).sum();
             for d in 0..D {
                 grad_c[d] -= normal_part * n[d];

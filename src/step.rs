@@ -77,15 +77,14 @@ pub struct StepReport {
 pub struct Workspace<const D: usize> {
     /// Summation density of the step (swapped into the particles).
     density: Vec<f64>,
-    /// How the neighbours fill each kernel support (free surface, shifting).
-    supports: Vec<Support<D>>,
+    /// The free surface's outward normal of each fluid particle, where shifting keeps to the
+    /// tangential direction (with shifting).
+    surface_normal: Vec<[f64; D]>,
     roles: Vec<Role>,
     /// The role of each particle as written to the frames (`Particles::free_surface`).
     free_surface: Vec<u8>,
     /// No free-surface particle in the kernel support.
     full_support: Vec<bool>,
-    /// Whether the moment matrix of the pressure gradient is invertible (`ppe::assign_roles`).
-    gradient_defined: Vec<bool>,
     /// Kernel gradient correction L_i of each particle, Eq. (25) (with the kernel correction).
     corrections: Vec<Correction<D>>,
     /// The correction L'_i of the pressure gradient, whose wall ghosts carry the normal part
@@ -116,11 +115,10 @@ impl<const D: usize> Default for Workspace<D> {
     fn default() -> Self {
         Self {
             density: Vec::new(),
-            supports: Vec::new(),
+            surface_normal: Vec::new(),
             roles: Vec::new(),
             free_surface: Vec::new(),
             full_support: Vec::new(),
-            gradient_defined: Vec::new(),
             corrections: Vec::new(),
             pressure_corrections: Vec::new(),
             eddy: Vec::new(),
@@ -214,11 +212,10 @@ impl<const D: usize> Workspace<D> {
     pub fn arrays(&self) -> Vec<(Stage, ArraySize)> {
         let Workspace {
             density,
-            supports,
+            surface_normal,
             roles,
             free_surface,
             full_support,
-            gradient_defined,
             corrections,
             pressure_corrections,
             eddy,
@@ -236,7 +233,6 @@ impl<const D: usize> Workspace<D> {
         } = self;
         let mut arrays = vec![
             (Stage::Density, ArraySize::of("density", density)),
-            (Stage::FreeSurface, ArraySize::of("support", supports)),
             (Stage::FreeSurface, ArraySize::of("PPE role", roles)),
             (
                 Stage::FreeSurface,
@@ -245,10 +241,6 @@ impl<const D: usize> Workspace<D> {
             (
                 Stage::FreeSurface,
                 ArraySize::of("full support", full_support),
-            ),
-            (
-                Stage::FreeSurface,
-                ArraySize::of("gradient defined", gradient_defined),
             ),
             (Stage::KernelCorrection, ArraySize::of("L", corrections)),
             (
@@ -276,6 +268,10 @@ impl<const D: usize> Workspace<D> {
                 Stage::WallPressure,
                 ArraySize::of("fluid through", fluid_through),
             ),
+            (
+                Stage::Shifting,
+                ArraySize::of("surface normal", surface_normal),
+            ),
             (Stage::Shifting, ArraySize::of_components("δr", shift)),
         ];
         let solver = bicgstab.arrays().into_iter().chain(multigrid.fine_arrays());
@@ -292,14 +288,13 @@ impl<const D: usize> Workspace<D> {
         });
     }
 
-    /// How each support is filled, from its moments (`sph::support_moments`); the free surface
-    /// and the role of each particle in the PPE. With the kernel correction the corrections
-    /// L_i and L'_i of Eq. (25) are inverted here from the same moments, once per step for
-    /// every operator below.
+    /// How each support is filled, from its moments (`sph::support_moments`): the free surface
+    /// and the role of each particle in the PPE (`ppe::role`), and with shifting the surface
+    /// normal. With the kernel correction the corrections L_i and L'_i of Eq. (25) are inverted
+    /// here from the same moments, once per step for every operator below.
     fn classify(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>) {
         let n = p.len();
-        self.supports.resize(n, Support::FULL);
-        self.gradient_defined.resize(n, false);
+        self.roles.resize(n, Role::Wall);
         self.free_surface.resize(n, 0);
         let corrections = if set.effects.kernel_correction {
             self.corrections.resize(n, None);
@@ -309,30 +304,38 @@ impl<const D: usize> Workspace<D> {
         } else {
             Either::Right((0..n).into_par_iter().map(|_| None))
         };
-        self.supports
+        let normals = if set.effects.shifting.is_some() {
+            self.surface_normal.resize(n, [0.0; D]);
+            Either::Left(self.surface_normal.par_iter_mut().map(Some))
+        } else {
+            Either::Right((0..n).into_par_iter().map(|_| None))
+        };
+        self.roles
             .par_iter_mut()
-            .zip(&mut self.gradient_defined)
+            .zip(normals)
             .zip(corrections)
             .enumerate()
-            .for_each(|(i, ((support, defined), corrections))| {
+            .for_each(|(i, ((role, normal), corrections))| {
                 let mo = p.is_fluid(i).then(|| sph::support_moments(nb, p, i));
                 let l_pressure = mo.and_then(|mo| sph::gradient_correction(mo.m_neumann));
-                *support = mo.map_or(Support::FULL, |mo| Support::new(&mo.m, mo.grad_c));
-                *defined = l_pressure.is_some();
+                let support = mo.map(|mo| Support::new(&mo.m, mo.grad_c));
+                *role = ppe::role(
+                    nb,
+                    p,
+                    support.as_ref(),
+                    l_pressure.is_some(),
+                    set.confined,
+                    i,
+                );
+                if let Some(normal) = normal {
+                    *normal = support.map_or([0.0; D], |s| s.normal);
+                }
                 if let Some((l, lp)) = corrections {
                     *l = mo.and_then(|mo| sph::gradient_correction(mo.m));
                     *lp = l_pressure;
                 }
             });
-        ppe::assign_roles(
-            nb,
-            p,
-            &self.supports,
-            &self.gradient_defined,
-            set.gravity,
-            set.confined,
-            &mut self.roles,
-        );
+        ppe::pin_reference(p, set.gravity, &mut self.roles);
         ppe::full_support(nb, &self.roles, &mut self.full_support);
         fill(&mut self.free_surface, |i| self.roles[i].code());
     }
@@ -563,9 +566,9 @@ impl<const D: usize> Workspace<D> {
         }
         let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
         let shifting = Shifting::new(nb, settings, set.spacing, max_speed, dt);
-        let (roles, supports, full, contact) = (
+        let (roles, normals, full, contact) = (
             &self.roles,
-            &self.supports,
+            &self.surface_normal,
             &self.full_support,
             &self.contact,
         );
@@ -573,7 +576,7 @@ impl<const D: usize> Workspace<D> {
             // Splashes are left in place: neither ∇C nor the Taylor correction means anything
             // there.
             Role::Interior | Role::Surface | Role::Reference => {
-                let dr = shifting.displacement(nb, p, &supports[i], full[i], i);
+                let dr = shifting.displacement(nb, p, normals[i], full[i], i);
                 wall::no_penetration(dr, wall::contact_normal(p, contact[i]))
             }
             Role::Splash | Role::Wall => [0.0; D],
