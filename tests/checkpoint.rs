@@ -259,6 +259,28 @@ fn a_continued_3d_run_is_bit_identical_to_one_never_stopped() {
     assert_same_run::<3>(&whole, &split, "3D stopped at T/2");
 }
 
+#[test]
+fn a_continued_periodic_run_is_bit_identical_to_one_never_stopped() {
+    let dir = TempDir::new("ckpt-periodic");
+    let edits = [("spacing = 0.02 ", "spacing = 0.04 ")];
+    let scene = Scene::load(&scene_file(
+        dir.path(),
+        "taylor_green_2d.toml",
+        &edits,
+        0.1,
+        2,
+    ))
+    .unwrap();
+    let (half, end) = (0.2, 0.4);
+    let whole = dir.path().join("whole");
+    run::run(&scene, &run_options(&whole, end)).unwrap();
+    let split = dir.path().join("split");
+    run::run(&scene, &run_options(&split, half)).unwrap();
+    let summary = resume_until(&split.join("checkpoints"), end);
+    assert!(summary.steps > 5, "only {} steps after T/2", summary.steps);
+    assert_same_run::<2>(&whole, &split, "periodic stopped at T/2");
+}
+
 fn isph(args: &[&str]) -> Output {
     isph_command().args(args).output().unwrap()
 }
