@@ -237,48 +237,35 @@ fn a_continued_2d_run_is_bit_identical_to_one_never_stopped() {
     assert_same_run::<2>(&whole, &rewound, "rewound to an older checkpoint");
 }
 
+/// Runs `scene` to `end` at once and to `half` then resumed to `end`: the two runs agree bit
+/// for bit.
+fn assert_split_run_is_identical<const D: usize>(dir: &Path, scene: &Scene, half: f64, end: f64) {
+    let whole = dir.join("whole");
+    run::run(scene, &run_options(&whole, end)).unwrap();
+    let split = dir.join("split");
+    run::run(scene, &run_options(&split, half)).unwrap();
+    let summary = resume_until(&split.join("checkpoints"), end);
+    assert!(summary.steps > 5, "only {} steps after T/2", summary.steps);
+    assert_same_run::<D>(&whole, &split, "stopped at T/2");
+}
+
 #[test]
 fn a_continued_3d_run_is_bit_identical_to_one_never_stopped() {
     let dir = TempDir::new("ckpt-3d");
     let edits = [("spacing = 0.02", "spacing = 0.04")];
-    let scene = Scene::load(&scene_file(
-        dir.path(),
-        "dam_break_3d.toml",
-        &edits,
-        0.04,
-        2,
-    ))
-    .unwrap();
-    let (half, end) = (3.0 * scene.output_interval, 6.0 * scene.output_interval);
-    let whole = dir.path().join("whole");
-    run::run(&scene, &run_options(&whole, end)).unwrap();
-    let split = dir.path().join("split");
-    run::run(&scene, &run_options(&split, half)).unwrap();
-    let summary = resume_until(&split.join("checkpoints"), end);
-    assert!(summary.steps > 5, "only {} steps after T/2", summary.steps);
-    assert_same_run::<3>(&whole, &split, "3D stopped at T/2");
+    let file = scene_file(dir.path(), "dam_break_3d.toml", &edits, 0.04, 2);
+    let scene = Scene::load(&file).unwrap();
+    let every = scene.output_interval;
+    assert_split_run_is_identical::<3>(dir.path(), &scene, 3.0 * every, 6.0 * every);
 }
 
 #[test]
 fn a_continued_periodic_run_is_bit_identical_to_one_never_stopped() {
     let dir = TempDir::new("ckpt-periodic");
     let edits = [("spacing = 0.02 ", "spacing = 0.04 ")];
-    let scene = Scene::load(&scene_file(
-        dir.path(),
-        "taylor_green_2d.toml",
-        &edits,
-        0.1,
-        2,
-    ))
-    .unwrap();
-    let (half, end) = (0.2, 0.4);
-    let whole = dir.path().join("whole");
-    run::run(&scene, &run_options(&whole, end)).unwrap();
-    let split = dir.path().join("split");
-    run::run(&scene, &run_options(&split, half)).unwrap();
-    let summary = resume_until(&split.join("checkpoints"), end);
-    assert!(summary.steps > 5, "only {} steps after T/2", summary.steps);
-    assert_same_run::<2>(&whole, &split, "periodic stopped at T/2");
+    let file = scene_file(dir.path(), "taylor_green_2d.toml", &edits, 0.1, 2);
+    let scene = Scene::load(&file).unwrap();
+    assert_split_run_is_identical::<2>(dir.path(), &scene, 0.2, 0.4);
 }
 
 fn isph(args: &[&str]) -> Output {
