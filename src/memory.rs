@@ -11,6 +11,9 @@ pub struct ArraySize {
     pub len: usize,
     /// Bytes allocated now (capacity × element size, over its components).
     pub allocated: usize,
+    /// One element per particle; false for a list of some particles only (`sparse`), whose
+    /// size depends on the state and is not in `bytes_per_particle`.
+    pub per_particle: bool,
 }
 
 impl ArraySize {
@@ -27,6 +30,17 @@ impl ArraySize {
             bytes_per_particle: size * v.len(),
             len: v.first().map_or(0, Vec::len),
             allocated: v.iter().map(|c| c.capacity() * size).sum(),
+            per_particle: true,
+        }
+    }
+
+    /// A list with an element for some particles only (those near the free surface, say): its
+    /// allocation counts, its size per particle is not known before a step.
+    pub fn sparse<T>(name: &'static str, v: &Vec<T>) -> Self {
+        Self {
+            bytes_per_particle: 0,
+            per_particle: false,
+            ..Self::of(name, v)
         }
     }
 }

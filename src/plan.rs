@@ -5,6 +5,7 @@
 
 use crate::scene::{Effects, Scene};
 use crate::simulation::{NoFluid, Simulation};
+use crate::sph::Correction;
 use crate::step;
 use crate::timings::Stage;
 use crate::{lattice, particles::Kind};
@@ -99,7 +100,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
         }
         Stage::Density => "summation density ρ_i = Σ_j m_j W_ij; walls keep ρ0".into(),
         Stage::FreeSurface => "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".into(),
-        Stage::KernelCorrection => "L_i = M_i⁻¹ (Eq. 24–25) for the divergence and velocity gradients, kept where the free surface is in reach; L'_i for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only); inverted in the free-surface pass from its moments".into(),
+        Stage::KernelCorrection => format!("L_i = M_i⁻¹ (Eq. 24–25) for the divergence and velocity gradients, only where the free surface is in reach and stored for those particles only ({} B each, not in the figure); L'_i for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only), inverted in the free-surface pass from its moments", sparse_correction_bytes(scene.dimensions)),
         Stage::EddyViscosity => format!(
             "Smagorinsky ν_t = (Cs Δ)² |S| (Eq. 3–4), Cs = {}, Δ = dx, walls as free-slip ghosts",
             effects.les.map_or(0.0, |les| les.cs)
@@ -193,4 +194,13 @@ impl fmt::Display for Plan {
             mib(total)
         )
     }
+}
+
+/// Bytes of one particle's entry in the sparse list of L_i: the matrix and the particle index.
+fn sparse_correction_bytes(dimensions: usize) -> usize {
+    let matrix = match dimensions {
+        2 => std::mem::size_of::<Correction<2>>(),
+        _ => std::mem::size_of::<Correction<3>>(),
+    };
+    matrix + std::mem::size_of::<u32>()
 }

@@ -196,22 +196,45 @@ pub fn invert<const D: usize>(mut m: [[f64; D]; D]) -> Option<([[f64; D]; D], f6
 /// L_i of Eq. (25), or None where the correction is not applied.
 pub type Correction<const D: usize> = Option<[[f64; D]; D]>;
 
-/// The corrections L_i of every particle, or the identity for all of them where the scene turns
-/// the kernel correction off (then no array of them exists).
+/// The corrections L_i of the particles: every particle's (`dense`), only those of the
+/// particles that have one (`sparse`: a slot per particle into a list), or the identity for all
+/// of them where the scene turns the kernel correction off (then no array of them exists).
 #[derive(Clone, Copy, Debug)]
-pub struct Corrections<'a, const D: usize>(Option<&'a [Correction<D>]>);
+pub struct Corrections<'a, const D: usize>(Option<Stored<'a, D>>);
+
+#[derive(Clone, Copy, Debug)]
+enum Stored<'a, const D: usize> {
+    Dense(&'a [Correction<D>]),
+    Sparse {
+        slot: &'a [u32],
+        list: &'a [Correction<D>],
+    },
+}
+
+/// The slot of a particle with no correction in a sparse `Corrections`.
+pub const NO_SLOT: u32 = u32::MAX;
 
 impl<'a, const D: usize> Corrections<'a, D> {
-    /// `l` where the correction is `on`, else the identity everywhere.
+    /// `l` (one per particle) where the correction is `on`, else the identity everywhere.
     pub fn new(on: bool, l: &'a [Correction<D>]) -> Self {
-        Self(on.then_some(l))
+        Self(on.then_some(Stored::Dense(l)))
+    }
+
+    /// `list[slot[i]]` for the particles with a slot, the identity for the others (`NO_SLOT`)
+    /// and for all where the correction is off.
+    pub fn sparse(on: bool, slot: &'a [u32], list: &'a [Correction<D>]) -> Self {
+        Self(on.then_some(Stored::Sparse { slot, list }))
     }
 
     /// L_i.
     #[inline]
     pub fn of(self, i: usize) -> &'a Correction<D> {
         match self.0 {
-            Some(l) => &l[i],
+            Some(Stored::Dense(l)) => &l[i],
+            Some(Stored::Sparse { slot, list }) => match slot[i] {
+                NO_SLOT => &None,
+                k => &list[k as usize],
+            },
             None => &None,
         }
     }

@@ -18,7 +18,7 @@ use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::{self, fill, fill_vector};
 use crate::scene::Effects;
 use crate::shifting::{Shifting, ShiftingSettings};
-use crate::sph::{self, Correction, Corrections, Neighbours};
+use crate::sph::{self, Correction, Corrections, Neighbours, NO_SLOT};
 use crate::timings::{Stage, Timings};
 use crate::turbulence::{self, LesSettings};
 use crate::wall;
@@ -87,6 +87,10 @@ pub struct Workspace<const D: usize> {
     full_support: Vec<bool>,
     /// Kernel gradient correction L_i of each particle, Eq. (25) (with the kernel correction).
     corrections: Vec<Correction<D>>,
+    /// Each particle's slot in `corrections` (`sph::NO_SLOT`: none, the particle has no free
+    /// surface in reach) and the particle of each slot (with the kernel correction).
+    correction_slot: Vec<u32>,
+    corrected: Vec<u32>,
     /// The correction L'_i of the pressure gradient, whose wall ghosts carry the normal part
     /// of the gradient only (see `sph::Moments`) (with the kernel correction).
     pressure_corrections: Vec<Correction<D>>,
@@ -120,6 +124,8 @@ impl<const D: usize> Default for Workspace<D> {
             free_surface: Vec::new(),
             full_support: Vec::new(),
             corrections: Vec::new(),
+            correction_slot: Vec::new(),
+            corrected: Vec::new(),
             pressure_corrections: Vec::new(),
             eddy: Vec::new(),
             u_star: components(),
@@ -168,7 +174,7 @@ impl<const D: usize> Workspace<D> {
             std::mem::swap(&mut p.free_surface, &mut self.free_surface);
             lap(Stage::FreeSurface);
             if effects.kernel_correction {
-                self.limit_corrections();
+                self.near_surface_corrections(&nb, p);
                 lap(Stage::KernelCorrection);
             }
             if let Some(les) = &effects.les {
@@ -217,6 +223,8 @@ impl<const D: usize> Workspace<D> {
             free_surface,
             full_support,
             corrections,
+            correction_slot,
+            corrected,
             pressure_corrections,
             eddy,
             u_star,
@@ -242,7 +250,15 @@ impl<const D: usize> Workspace<D> {
                 Stage::FreeSurface,
                 ArraySize::of("full support", full_support),
             ),
-            (Stage::KernelCorrection, ArraySize::of("L", corrections)),
+            (Stage::KernelCorrection, ArraySize::sparse("L", corrections)),
+            (
+                Stage::KernelCorrection,
+                ArraySize::of("slot of L", correction_slot),
+            ),
+            (
+                Stage::KernelCorrection,
+                ArraySize::sparse("particle of L", corrected),
+            ),
             (
                 Stage::KernelCorrection,
                 ArraySize::of("L'", pressure_corrections),
@@ -297,10 +313,8 @@ impl<const D: usize> Workspace<D> {
         self.roles.resize(n, Role::Wall);
         self.free_surface.resize(n, 0);
         let corrections = if set.effects.kernel_correction {
-            self.corrections.resize(n, None);
             self.pressure_corrections.resize(n, None);
-            let pairs = self.corrections.par_iter_mut();
-            Either::Left(pairs.zip(&mut self.pressure_corrections).map(Some))
+            Either::Left(self.pressure_corrections.par_iter_mut().map(Some))
         } else {
             Either::Right((0..n).into_par_iter().map(|_| None))
         };
@@ -330,8 +344,7 @@ impl<const D: usize> Workspace<D> {
                 if let Some(normal) = normal {
                     *normal = support.map_or([0.0; D], |s| s.normal);
                 }
-                if let Some((l, lp)) = corrections {
-                    *l = mo.and_then(|mo| sph::gradient_correction(mo.m));
+                if let Some(lp) = corrections {
                     *lp = l_pressure;
                 }
             });
@@ -344,16 +357,27 @@ impl<const D: usize> Workspace<D> {
     /// the particles, not a truncated support: corrected there, the divergence of the PPE
     /// source amplifies that disorder into the pressure (measured: a collision of two blocks
     /// gains energy instead of losing it). So L_i is kept only where the free surface is in
-    /// reach. The pressure gradient keeps its correction L'_i everywhere, which inside the fluid
-    /// corrects the wall ghosts' missing tangential gradient.
-    fn limit_corrections(&mut self) {
+    /// reach, and stored for those particles only (a few per cent of a large run): their slots
+    /// are given out in index order, then L_i is inverted from the moments of each. The pressure
+    /// gradient keeps its correction L'_i everywhere, which inside the fluid corrects the wall
+    /// ghosts' missing tangential gradient.
+    fn near_surface_corrections(&mut self, nb: &Neighbours<D>, p: &Particles<D>) {
+        self.correction_slot.resize(p.len(), NO_SLOT);
+        self.corrected.clear();
+        for (i, slot) in self.correction_slot.iter_mut().enumerate() {
+            *slot = if p.is_fluid(i) && !self.full_support[i] {
+                self.corrected.push(i as u32);
+                (self.corrected.len() - 1) as u32
+            } else {
+                NO_SLOT
+            };
+        }
+        self.corrections.resize(self.corrected.len(), None);
         self.corrections
             .par_iter_mut()
-            .zip(&self.full_support)
-            .for_each(|(l, &full)| {
-                if full {
-                    *l = None;
-                }
+            .zip(&self.corrected)
+            .for_each(|(l, &i)| {
+                *l = sph::gradient_correction(sph::support_moments(nb, p, i as usize).m);
             });
     }
 
@@ -366,7 +390,11 @@ impl<const D: usize> Workspace<D> {
         les: &LesSettings,
     ) {
         self.eddy.resize(p.len(), 0.0);
-        let corrections = Corrections::new(set.effects.kernel_correction, &self.corrections);
+        let corrections = Corrections::sparse(
+            set.effects.kernel_correction,
+            &self.correction_slot,
+            &self.corrections,
+        );
         fill(&mut self.eddy, |i| match p.kind[i] {
             Kind::Fluid => {
                 turbulence::eddy_viscosity(nb, p, corrections.of(i), les.cs, set.spacing, i)
@@ -434,7 +462,7 @@ impl<const D: usize> Workspace<D> {
             &op,
             &self.full_support,
             set.spacing,
-            Corrections::new(kernel_correction, &self.corrections),
+            Corrections::sparse(kernel_correction, &self.correction_slot, &self.corrections),
             &self.u_star,
             dt,
             set.alpha,
@@ -582,7 +610,11 @@ impl<const D: usize> Workspace<D> {
             Role::Splash | Role::Wall => [0.0; D],
         });
         let shift = &self.shift;
-        let corrections = Corrections::new(set.effects.kernel_correction, &self.corrections);
+        let corrections = Corrections::sparse(
+            set.effects.kernel_correction,
+            &self.correction_slot,
+            &self.corrections,
+        );
         fill_vector(&mut self.velocity, |i| match p.kind[i] {
             Kind::Fluid => {
                 // Where the free surface is in reach the velocity gradient is no longer that of
