@@ -32,21 +32,18 @@ impl<const D: usize> CellList<D> {
     /// particle then never meets two images of another), and a neighbour search near one end
     /// continues at the other.
     pub fn new(lo: [f64; D], hi: [f64; D], cell: f64, periodic: [bool; D]) -> Self {
-        let count: [usize; D] =
-            std::array::from_fn(|d| ((hi[d] - lo[d]) / cell).ceil().max(1.0) as usize);
-        let period = std::array::from_fn(|d| periodic[d].then_some((lo[d], hi[d] - lo[d])));
-        let width: [f64; D] = std::array::from_fn(|d| match period[d] {
+        let period: [Option<(f64, f64)>; D] =
+            std::array::from_fn(|d| periodic[d].then_some((lo[d], hi[d] - lo[d])));
+        // Interior cells and cell width per axis.
+        let cells: [(usize, f64); D] = std::array::from_fn(|d| match period[d] {
             Some((_, length)) => {
-                let cells = (length / cell).floor();
-                assert!(cells >= 3.0, "a periodic axis spans at least three cells");
-                length / cells
+                let count = (length / cell).floor();
+                assert!(count >= 3.0, "a periodic axis spans at least three cells");
+                (count as usize, length / count)
             }
-            None => cell,
+            None => (((hi[d] - lo[d]) / cell).ceil().max(1.0) as usize, cell),
         });
-        let dims = std::array::from_fn(|d| match period[d] {
-            Some((_, length)) => (length / width[d]).round() as usize + 2,
-            None => count[d] + 2,
-        });
+        let (dims, width) = (cells.map(|(n, _)| n + 2), cells.map(|(_, w)| w));
         let origin = std::array::from_fn(|d| lo[d] - width[d]);
         let ncells: usize = dims.iter().product();
         Self {

@@ -16,13 +16,9 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let dx = scene.spacing;
     let volume = dx.powi(D as i32);
     let layers = wall_layers(scene) as i64;
-    let lo = &scene.container.min;
-    // Lattice point k (per axis) sits at lo + (k + ½) dx.
-    let cells: [i64; D] =
-        std::array::from_fn(|d| ((scene.container.max[d] - lo[d]) / dx).round() as i64);
-    let point =
-        |k: [i64; D]| -> [f64; D] { std::array::from_fn(|d| lo[d] + (k[d] as f64 + 0.5) * dx) };
-    let in_obstacle = |x: &[f64; D]| scene.obstacles.iter().any(|o| o.contains(x));
+    let cells = container_cells::<D>(scene);
+    let point = |k: [i64; D]| lattice_point(scene, k);
+    let in_obstacle = |x: &[f64; D]| in_obstacle(scene, x);
 
     let mut particles = Particles::<D>::default();
     // A lattice point belongs to the first block that contains it.
@@ -84,16 +80,27 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
 /// obstacles holds a fluid particle. Incompressible fluid that fills a closed or periodic box
 /// has no free surface, and can never make one.
 pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) -> bool {
-    let dx = scene.spacing;
-    let lo = &scene.container.min;
-    let cells: [i64; D] =
-        std::array::from_fn(|d| ((scene.container.max[d] - lo[d]) / dx).round() as i64);
     let mut room = 0;
-    for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
-        let x: [f64; D] = std::array::from_fn(|d| lo[d] + (k[d] as f64 + 0.5) * dx);
-        room += !scene.obstacles.iter().any(|o| o.contains(&x)) as usize;
+    for_each_lattice_point([0; D], container_cells::<D>(scene), |k| {
+        room += !in_obstacle(scene, &lattice_point(scene, k)) as usize;
     });
     particles.fluid_count() == room
+}
+
+/// Lattice points per axis inside the container.
+fn container_cells<const D: usize>(scene: &Scene) -> [i64; D] {
+    let (lo, hi) = (&scene.container.min, &scene.container.max);
+    std::array::from_fn(|d| ((hi[d] - lo[d]) / scene.spacing).round() as i64)
+}
+
+/// Lattice point k (per axis): container.min + (k + ½) dx.
+fn lattice_point<const D: usize>(scene: &Scene, k: [i64; D]) -> [f64; D] {
+    let lo = &scene.container.min;
+    std::array::from_fn(|d| lo[d] + (k[d] as f64 + 0.5) * scene.spacing)
+}
+
+fn in_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
+    scene.obstacles.iter().any(|o| o.contains(x))
 }
 
 /// Calls `f` for every integer point k with lo ≤ k < hi, x fastest.

@@ -111,18 +111,21 @@ pub fn role<const D: usize>(
 
 /// If the fluid has no free surface at all (a full closed or periodic box) the PPE is singular;
 /// the highest fluid particle (the first in index order among equals) is then the reference,
-/// pinned to P = 0.
-pub fn pin_reference<const D: usize>(p: &Particles<D>, gravity: [f64; D], roles: &mut [Role]) {
+/// pinned to P = 0. Returns it (None: the fluid has a free surface, and no reference).
+pub fn pin_reference<const D: usize>(
+    p: &Particles<D>,
+    gravity: [f64; D],
+    roles: &mut [Role],
+) -> Option<usize> {
     if roles.iter().any(|r| r.is_free()) {
-        return;
+        return None;
     }
     let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
     let top = (0..p.len())
         .filter(|&i| roles[i] == Role::Interior)
-        .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)));
-    if let Some(top) = top {
-        roles[top] = Role::Reference;
-    }
+        .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)))?;
+    roles[top] = Role::Reference;
+    Some(top)
 }
 
 /// Marks fluid particles whose kernel support holds no free-surface particle: there the
@@ -193,21 +196,13 @@ pub fn source<const D: usize>(
         Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
         Role::Splash | Role::Wall | Role::Reference => 0.0,
     });
-    if is_closed(op.roles) {
-        remove_net_compression(op.roles, b);
-    }
-}
-
-/// Whether the fluid has no free surface: its pressure is then fixed by the reference particle.
-pub fn is_closed(roles: &[Role]) -> bool {
-    roles.contains(&Role::Reference)
 }
 
 /// In a closed box the interior rows' sources must sum to zero: the volume cannot change, and
 /// a net source would have nowhere to go but the reference particle's row (a spurious point
 /// source of pressure there). The SPH divergence and the density term leave a small net sum
 /// (from the disorder of the particles); it is removed evenly from every interior row.
-fn remove_net_compression(roles: &[Role], b: &mut [f64]) {
+pub fn remove_net_compression(roles: &[Role], b: &mut [f64]) {
     let [count, sum] = crate::reduce::sums(b.len(), |i| {
         if roles[i] == Role::Interior {
             [1.0, b[i]]

@@ -3,7 +3,7 @@
 
 pub use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
-use crate::wall::{self, behind_walls, ghost_velocity};
+use crate::wall::{self, behind_walls, ghost_velocity, Face};
 
 /// Summation density ρ_i = Σ_j m_j W_ij (self included).
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
@@ -15,7 +15,8 @@ pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -
 /// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, ν_t the eddy viscosity
 /// of the Smagorinsky model (Eq. 3–4) where the scene runs LES (`eddy`; None: ν_t = 0). Wall
 /// particles take the fluid's laminar viscosity (the turbulent stress at a wall is the law of
-/// the wall's, `turbulence::wall_shear`) and the no-slip velocity of Morris, Fox & Zhu (1997):
+/// the wall's, `turbulence::wall_shear`) and the no-slip velocity of Morris, Fox & Zhu (1997),
+/// with `face` the nearest wall's in the kernel support (`wall::nearest_face`):
 /// u_b = −(d_b/d_i) u_i with d the distances to the wall face, which puts u = 0 on the face
 /// itself, so u_i − u_b = β u_i with β = 1 + d_b/d_i = n_b·r_ib/d_i, capped at
 /// `MORRIS_BETA_MAX` for the wall particles deep behind the face. (Walls simply at rest, β = 1, put
@@ -25,13 +26,12 @@ pub fn viscous_acceleration<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     eddy: Option<&[f64]>,
-    spacing: f64,
+    face: Option<Face<D>>,
     i: usize,
 ) -> [f64; D] {
     let nu_t = |j: usize| eddy.map_or(0.0, |e| e[j]);
     let (rho_i, nu_i) = (p.rest_density[i], p.viscosity[i] + nu_t(i));
-    let face = wall::face_distance(nb, p, spacing, nb.kernel.support(), i);
-    let d_i = face.map_or(f64::INFINITY, |(d, _)| d);
+    let d_i = face.map_or(f64::INFINITY, |f| f.distance);
     let u_i = p.velocity(i);
     let mut acc = [0.0; D];
     nb.for_each(i, |j, r_ij, r| {
@@ -57,7 +57,7 @@ pub fn viscous_acceleration<const D: usize>(
 }
 
 /// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right
-/// at the face (d_i → 0); here d_i ≥ dx/4 (`wall::face_distance`) bounds β anyway, and a cap of
+/// at the face (d_i → 0); here d_i ≥ dx/4 (`wall::Face::distance`) bounds β anyway, and a cap of
 /// 1.5 leaves the Poiseuille channel 4.2% too fast (4: 0.48%, no cap: 0.47%).
 const MORRIS_BETA_MAX: f64 = 4.0;
 

@@ -81,6 +81,9 @@ pub struct Workspace<const D: usize> {
     /// tangential direction (with shifting).
     surface_normal: Vec<[f64; D]>,
     roles: Vec<Role>,
+    /// The particle pinned to P = 0 where the fluid has no free surface (`ppe::pin_reference`;
+    /// None: the fluid has one, its pressure is absolute and cannot hold a tension).
+    reference: Option<usize>,
     /// The role of each particle as written to the frames (`Particles::free_surface`).
     free_surface: Vec<u8>,
     /// No free-surface particle in the kernel support.
@@ -121,6 +124,7 @@ impl<const D: usize> Default for Workspace<D> {
             density: Vec::new(),
             surface_normal: Vec::new(),
             roles: Vec::new(),
+            reference: None,
             free_surface: Vec::new(),
             full_support: Vec::new(),
             corrections: Vec::new(),
@@ -184,7 +188,7 @@ impl<const D: usize> Workspace<D> {
             self.predict(&nb, p, set, dt);
             lap(Stage::Predictor);
             let solve = self.solve_pressure(&nb, p, set, dt)?;
-            let clip = !ppe::is_closed(&self.roles);
+            let clip = self.reference.is_none();
             fill(&mut p.pressure, |i| cavitation(clip, self.pressure[i]));
             lap(Stage::PressureSolve);
             self.correct(&nb, p, set, dt);
@@ -220,6 +224,7 @@ impl<const D: usize> Workspace<D> {
             density,
             surface_normal,
             roles,
+            reference: _,
             free_surface,
             full_support,
             corrections,
@@ -348,7 +353,7 @@ impl<const D: usize> Workspace<D> {
                     *lp = l_pressure;
                 }
             });
-        ppe::pin_reference(p, set.gravity, &mut self.roles);
+        self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
         ppe::full_support(nb, &self.roles, &mut self.full_support);
         fill(&mut self.free_surface, |i| self.roles[i].code());
     }
@@ -413,11 +418,14 @@ impl<const D: usize> Workspace<D> {
         let (spacing, gravity, les) = (set.spacing, set.gravity, set.effects.les);
         let eddy = les.is_some().then_some(&self.eddy[..]);
         let wall_function = les.is_some_and(|les| les.wall_function);
+        let support = nb.kernel.support();
         fill_vector(&mut self.u_star, |i| match p.kind[i] {
             Kind::Fluid => {
-                let visc = sph::viscous_acceleration(nb, p, eddy, spacing, i);
+                // The nearest wall, for the no-slip wall velocity and the wall function.
+                let face = wall::nearest_face(nb, p, spacing, support, i);
+                let visc = sph::viscous_acceleration(nb, p, eddy, face, i);
                 let wall = if wall_function {
-                    turbulence::wall_shear(nb, p, spacing, i)
+                    turbulence::wall_shear(p, spacing, face, i)
                 } else {
                     [0.0; D]
                 };
@@ -468,12 +476,12 @@ impl<const D: usize> Workspace<D> {
             set.alpha,
             &mut self.rhs,
         );
+        if self.reference.is_some() {
+            ppe::remove_net_compression(&self.roles, &mut self.rhs);
+        }
         let roles = &self.roles;
         // In a closed box the last pressure is shifted to the new reference's level.
-        let level = roles
-            .iter()
-            .position(|&r| r == Role::Reference)
-            .map_or(0.0, |r| p.pressure[r]);
+        let level = self.reference.map_or(0.0, |r| p.pressure[r]);
         fill(&mut self.pressure, |i| match roles[i] {
             Role::Interior | Role::Surface => p.pressure[i] - level,
             Role::Splash | Role::Wall | Role::Reference => 0.0,
@@ -485,7 +493,7 @@ impl<const D: usize> Workspace<D> {
             &mut self.pressure,
             set.solver,
         )?;
-        if ppe::is_closed(roles) {
+        if self.reference.is_some() {
             zero_mean_pressure(p, &mut self.pressure);
         }
         Ok(info)
@@ -637,7 +645,7 @@ impl<const D: usize> Workspace<D> {
         });
         let pressure_corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
-        let clip = !ppe::is_closed(roles);
+        let clip = self.reference.is_none();
         fill(&mut self.pressure, |i| match p.kind[i] {
             Kind::Fluid => {
                 let g = pressure_gradient(nb, p, set.gravity, pressure_corrections.of(i), i);

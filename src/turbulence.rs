@@ -17,7 +17,7 @@
 
 use crate::particles::Particles;
 use crate::sph::{fluid_velocity, velocity_gradient, Correction, Neighbours};
-use crate::wall;
+use crate::wall::Face;
 
 /// The constants of the turbulence model (the scene's `[effects.les]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,16 +67,21 @@ pub fn eddy_viscosity<const D: usize>(
     cs_delta * cs_delta * (2.0 * ss).sqrt()
 }
 
-/// The acceleration of fluid particle i by the turbulent part of the wall shear stress: zero
-/// unless a wall particle lies within 1.5 dx (the particle touches the wall) and the particle
-/// sits in the log layer.
+/// The acceleration of fluid particle i by the turbulent part of the wall shear stress, with
+/// `face` the nearest wall's (`wall::nearest_face`): zero unless a wall particle lies within
+/// 1.5 dx (the particle touches the wall) and the particle sits in the log layer.
 pub fn wall_shear<const D: usize>(
-    nb: &Neighbours<D>,
     p: &Particles<D>,
     spacing: f64,
+    face: Option<Face<D>>,
     i: usize,
 ) -> [f64; D] {
-    let Some((y, n)) = wall::face_distance(nb, p, spacing, 1.5 * spacing, i) else {
+    let Some(Face {
+        distance: y,
+        normal: n,
+        ..
+    }) = face.filter(|f| f.reach < 1.5 * spacing)
+    else {
         return [0.0; D];
     };
     let u = p.velocity(i);

@@ -86,36 +86,51 @@ pub fn wall_pressure<const D: usize>(
     }
 }
 
-/// The wall particle b nearest to particle i closer than `within`, with r_ib, if any.
+/// The wall particle b nearest to particle i closer than `within`, with r_ib and |r_ib|, if any.
 pub fn nearest_wall<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     within: f64,
     i: usize,
-) -> Option<(usize, [f64; D])> {
+) -> Option<(usize, [f64; D], f64)> {
     let mut nearest = (within, None);
     nb.for_each(i, |j, rij, r| {
         if !p.is_fluid(j) && r < nearest.0 {
             nearest = (r, Some((j, rij)));
         }
     });
-    nearest.1
+    nearest.1.map(|(j, rij)| (j, rij, nearest.0))
 }
 
-/// Distance from fluid particle i to the face of the nearest wall whose particles come closer
-/// than `within`, with that wall's normal: the nearest wall particle's separation along its
-/// normal less the half spacing from a wall particle's centre to the face, and at least a
-/// quarter spacing (a particle pressed against the face).
-pub fn face_distance<const D: usize>(
+/// The face of the wall nearest to a fluid particle.
+#[derive(Clone, Copy, Debug)]
+pub struct Face<const D: usize> {
+    /// Distance from the particle to the face: the nearest wall particle's separation along
+    /// its normal less the half spacing from a wall particle's centre to the face, and at
+    /// least a quarter spacing (a particle pressed against the face).
+    pub distance: f64,
+    /// The wall's normal, into the fluid.
+    pub normal: [f64; D],
+    /// Distance from the particle to the nearest wall particle.
+    pub reach: f64,
+}
+
+/// The face of the nearest wall whose particles come closer to fluid particle i than
+/// `within`, if any.
+pub fn nearest_face<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     spacing: f64,
     within: f64,
     i: usize,
-) -> Option<(f64, [f64; D])> {
-    let (b, r_ib) = nearest_wall(nb, p, within, i)?;
-    let n = p.wall_normal(b);
-    Some(((dot(r_ib, n) - 0.5 * spacing).max(0.25 * spacing), n))
+) -> Option<Face<D>> {
+    let (b, r_ib, reach) = nearest_wall(nb, p, within, i)?;
+    let normal = p.wall_normal(b);
+    Some(Face {
+        distance: (dot(r_ib, normal) - 0.5 * spacing).max(0.25 * spacing),
+        normal,
+        reach,
+    })
 }
 
 /// `contact` of a particle touching no wall.
@@ -129,7 +144,7 @@ pub fn contact<const D: usize>(
     spacing: f64,
     i: usize,
 ) -> u32 {
-    nearest_wall(nb, p, spacing, i).map_or(NO_CONTACT, |(b, _)| b as u32)
+    nearest_wall(nb, p, spacing, i).map_or(NO_CONTACT, |(b, _, _)| b as u32)
 }
 
 /// The normal of the wall a particle touches (`contact`), zero where it touches none.
