@@ -41,7 +41,7 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
     let mut grid = setup.grid.clone();
     let (mut cells, mut order) = (Vec::new(), Vec::new());
     g.bench_function(label("cell_sort"), |b| {
-        b.iter(|| grid.sort(&p.pos, &mut cells, &mut order).unwrap())
+        b.iter(|| grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap())
     });
 
     g.sample_size(50)

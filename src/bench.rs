@@ -12,7 +12,7 @@ use crate::child::{self, peak_resident_bytes, ChildError};
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::linsolve::LinearOperator;
-use crate::particles::Particles;
+use crate::particles::{Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::fill;
 use crate::scene::{Scene, SceneError};
@@ -266,7 +266,7 @@ impl<const D: usize> PpeSetup<D> {
             std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MIN, f64::max) + support);
         let mut grid = CellList::new(lo, hi, support, [false; D]);
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
-        grid.sort(&p.pos, &mut cells, &mut order)
+        grid.sort(&p.pos, &p.kind, &mut cells, &mut order)
             .expect("the grid spans the particles' bounding box");
         p.permute(&order, &mut scratch);
         let mut roles = vec![Role::Wall; p.len()];
@@ -312,15 +312,16 @@ impl<const D: usize> PpeSetup<D> {
         }
     }
 
-    /// Neighbour pairs of the interior rows, the only rows that visit their neighbours (the
-    /// others are identity rows): the pair interactions of one apply.
+    /// Fluid neighbour pairs of the interior rows, the only rows that visit their neighbours
+    /// (the others are identity rows) and the only pairs they visit (the walls' are known
+    /// numbers, in the right-hand side): the pair interactions of one apply.
     pub fn pairs(&self, nb: &Neighbours<D>) -> usize {
         (0..self.roles.len())
             .into_par_iter()
             .filter(|&i| self.roles[i] == Role::Interior)
             .map(|i| {
                 let mut n = 0;
-                nb.for_each(i, |_, _, _| n += 1);
+                nb.for_each_of(i, &[Kind::Fluid], |_, _, _| n += 1);
                 n
             })
             .sum()

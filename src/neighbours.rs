@@ -1,5 +1,6 @@
-//! The pair loop every operator is built on. The particles are sorted by cell (`grid`), so the
-//! neighbours of particle i lie in 3^(D−1) contiguous index ranges; the loop walks each range
+//! The pair loop every operator is built on. The particles are sorted by kind and cell (`grid`),
+//! so the neighbours of particle i lie in a few contiguous index ranges, one per row of cells
+//! within reach and kind (operators that need one kind only visit its ranges); the loop walks each range
 //! four particles at a time in SIMD lanes (`wide::f64x4`): positions are loaded contiguously,
 //! the distance test and the kernel are evaluated for four pairs at once, and each operator
 //! accumulates in lanes, summed at the end in a fixed order. Lanes past the end of a range (and
@@ -8,8 +9,9 @@
 //! `for_each` offers the same walk one neighbour at a time, for the operators that run once per
 //! step; the hot loops (the PPE apply, density, …) work on the lanes directly.
 
-use crate::grid::CellList;
+use crate::grid::{CellList, KINDS};
 use crate::kernel::Quintic;
+use crate::particles::Kind;
 use wide::{f64x4, CmpLt};
 
 /// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
@@ -30,6 +32,8 @@ pub struct Lanes<const D: usize> {
     pub r: f64x4,
     /// All bits set in the lanes that are neighbours (inside the support, j ≠ i), zero elsewhere.
     pub mask: f64x4,
+    /// The kind of the four candidates (a range holds particles of one kind).
+    pub kind: Kind,
 }
 
 impl<const D: usize> Lanes<D> {
@@ -88,43 +92,63 @@ impl<'a, const D: usize> Neighbours<'a, D> {
     }
 
     /// The pair loop in lanes: calls `f` with every chunk of four candidates around particle
-    /// i that holds at least one neighbour.
+    /// i that holds at least one neighbour, over the particles of every kind.
     #[inline(always)]
-    pub fn for_each_lanes(&self, i: usize, mut f: impl FnMut(&Lanes<D>)) {
+    pub fn for_each_lanes(&self, i: usize, f: impl FnMut(&Lanes<D>)) {
+        self.for_each_lanes_of(i, &KINDS, f);
+    }
+
+    /// The pair loop in lanes over the neighbours of `kinds` only.
+    #[inline(always)]
+    pub fn for_each_lanes_of(&self, i: usize, kinds: &[Kind], mut f: impl FnMut(&Lanes<D>)) {
         let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
         let support2 = f64x4::splat(self.support2);
         // `xi` is i's image next to the range (itself but across a periodic boundary).
-        self.grid.for_each_neighbour_range(xi, |range, xi| {
-            let mut j0 = range.start;
-            while j0 < range.end {
-                let rij: [f64x4; D] =
-                    std::array::from_fn(|d| f64x4::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL));
-                let r2 = rij.iter().fold(f64x4::ZERO, |s, x| x.mul_add(*x, s));
-                let mut mask = r2.cmp_lt(support2);
-                let own = i.wrapping_sub(j0);
-                if own < LANES || j0 + LANES > range.end {
-                    let mut bits = mask.to_array();
-                    for (k, bit) in bits.iter_mut().enumerate() {
-                        if j0 + k == i || j0 + k >= range.end {
-                            *bit = 0.0;
+        self.grid
+            .for_each_neighbour_range(xi, kinds, |range, xi, kind| {
+                let mut j0 = range.start;
+                while j0 < range.end {
+                    let rij: [f64x4; D] = std::array::from_fn(|d| {
+                        f64x4::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL)
+                    });
+                    let r2 = rij.iter().fold(f64x4::ZERO, |s, x| x.mul_add(*x, s));
+                    let mut mask = r2.cmp_lt(support2);
+                    let own = i.wrapping_sub(j0);
+                    if own < LANES || j0 + LANES > range.end {
+                        let mut bits = mask.to_array();
+                        for (k, bit) in bits.iter_mut().enumerate() {
+                            if j0 + k == i || j0 + k >= range.end {
+                                *bit = 0.0;
+                            }
                         }
+                        mask = f64x4::from(bits);
                     }
-                    mask = f64x4::from(bits);
+                    if mask.any() {
+                        let r = (r2 & mask).sqrt();
+                        f(&Lanes {
+                            j0,
+                            rij,
+                            r,
+                            mask,
+                            kind,
+                        });
+                    }
+                    j0 += LANES;
                 }
-                if mask.any() {
-                    let r = (r2 & mask).sqrt();
-                    f(&Lanes { j0, rij, r, mask });
-                }
-                j0 += LANES;
-            }
-        });
+            });
     }
 
     /// The pair loop one neighbour at a time: calls `f(j, r_ij, |r_ij|)` for every particle
     /// j ≠ i inside the kernel support of i.
     #[inline(always)]
-    pub fn for_each(&self, i: usize, mut f: impl FnMut(usize, [f64; D], f64)) {
-        self.for_each_lanes(i, |l| {
+    pub fn for_each(&self, i: usize, f: impl FnMut(usize, [f64; D], f64)) {
+        self.for_each_of(i, &KINDS, f);
+    }
+
+    /// `for_each` over the neighbours of `kinds` only.
+    #[inline(always)]
+    pub fn for_each_of(&self, i: usize, kinds: &[Kind], mut f: impl FnMut(usize, [f64; D], f64)) {
+        self.for_each_lanes_of(i, kinds, |l| {
             let r = l.r.to_array();
             let rij = l.rij.map(|x| x.to_array());
             for k in 0..LANES {

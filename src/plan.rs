@@ -111,7 +111,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
             None => "Eq. (5): u* = u + Δt (∇·(ν∇u) (Eq. 26) + g), no-slip wall pairs".into(),
         },
         Stage::PressureSolve => format!(
-            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: Neumann ghosts of the fluid pressure (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by an aggregation multigrid V-cycle over the cell grid, warm start",
+            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: Neumann ghosts of the fluid pressure (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start",
             if effects.kernel_correction { " (corrected by L_i)" } else { "" },
             scene.solver.alpha
         ),

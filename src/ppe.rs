@@ -307,29 +307,39 @@ pub struct PressureOperator<'a, const D: usize> {
     pub gravity: [f64; D],
 }
 
+/// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
+struct Row<const D: usize> {
+    scale: f64x4,
+    c: [f64x4; D],
+}
+
 impl<const D: usize> PressureOperator<'_, D> {
-    /// Weights of (P_i − P_j) in the interior row i for the lanes `l`, with `volume` the
-    /// volumes V_j of the lanes that count (zero for the others): max(a_ij − V_j ĉ_i·∇W_ij, 0),
-    /// a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
+    fn row_constants(&self, i: usize) -> Row<D> {
+        Row {
+            scale: f64x4::splat(-2.0 / self.p.rest_density[i]),
+            c: std::array::from_fn(|d| f64x4::splat(self.row_vectors[d][i])),
+        }
+    }
+
+    /// Weights of (P_i − P_j) in the interior row i (constants `row`) for the lanes `l`, with
+    /// `mass` and `volume` the masses m_j and volumes V_j of the lanes:
+    /// max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
     #[inline(always)]
-    fn interior_weights(&self, i: usize, l: &Lanes<D>, volume: f64x4) -> f64x4 {
-        let (nb, p) = (self.nb, self.p);
-        let (f, laplacian_factor) = nb.gradient_and_laplacian_factors4(l.r);
-        let mass = volume * l.load(&p.rest_density);
-        let laplacian = f64x4::splat(-2.0 / p.rest_density[i]) * mass * laplacian_factor;
-        let correction = volume * f * self.row_vector_dot(i, l);
+    fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, mass: f64x4, volume: f64x4) -> f64x4 {
+        let (f, laplacian_factor) = self.nb.gradient_and_laplacian_factors4(l.r);
+        let laplacian = row.scale * mass * laplacian_factor;
+        let c_r = (0..D).fold(f64x4::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
+        let correction = volume * f * c_r;
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
         (laplacian - correction).max(f64x4::ZERO) & l.mask
     }
 
-    /// ĉ_i·r_ij per lane.
+    /// The weights of interior row i with its fluid neighbours `l`.
     #[inline(always)]
-    fn row_vector_dot(&self, i: usize, l: &Lanes<D>) -> f64x4 {
-        (0..D).fold(f64x4::ZERO, |s, d| {
-            f64x4::splat(self.row_vectors[d][i]).mul_add(l.rij[d], s)
-        })
+    fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> f64x4 {
+        self.interior_weights(row, l, l.load(&self.p.mass), l.load(self.fluid_volume))
     }
 
     /// P_b − P_i of the wall lanes (see `wall::ghost_pressure_difference`).
@@ -343,32 +353,29 @@ impl<const D: usize> PressureOperator<'_, D> {
         f64x4::splat(-p.rest_density[i]) * g_r
     }
 
-    /// Volumes of the wall lanes.
-    #[inline(always)]
-    fn wall_volumes(&self, l: &Lanes<D>) -> f64x4 {
-        l.load(&self.p.mass) / l.load(&self.p.rest_density) - l.load(self.fluid_volume)
-    }
-
     /// The wall part of the right-hand side of interior row i: the Neumann ghosts' known
     /// differences.
     fn wall_source(&self, i: usize) -> f64 {
+        let (p, row) = (self.p, self.row_constants(i));
         let mut b = f64x4::ZERO;
-        self.nb.for_each_lanes(i, |l| {
-            b += self.interior_weights(i, l, self.wall_volumes(l)) * self.ghosts(i, l);
+        self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
+            let mass = l.load(&p.mass);
+            let w = self.interior_weights(&row, l, mass, mass / l.load(&p.rest_density));
+            b += w * self.ghosts(i, l);
         });
         b.reduce_add()
     }
 
-    /// (A x)_i.
+    /// (A x)_i: the interior rows couple fluid neighbours only (the walls' pairs are known
+    /// numbers, in the right-hand side).
     #[inline]
     fn row(&self, x: &[f64], i: usize) -> f64 {
         match self.roles[i] {
             Role::Interior => {
-                let xi = f64x4::splat(x[i]);
+                let (xi, row) = (f64x4::splat(x[i]), self.row_constants(i));
                 let mut ax = f64x4::ZERO;
-                self.nb.for_each_lanes(i, |l| {
-                    let w = self.interior_weights(i, l, l.load(self.fluid_volume));
-                    ax = w.mul_add(xi - l.load(x), ax);
+                self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+                    ax = self.fluid_weights(&row, l).mul_add(xi - l.load(x), ax);
                 });
                 ax.reduce_add()
             }
@@ -392,9 +399,8 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
             let mut d = f64x4::ZERO;
             match self.roles[i] {
                 Role::Interior => {
-                    nb.for_each_lanes(i, |l| {
-                        d += self.interior_weights(i, l, l.load(self.fluid_volume))
-                    });
+                    let row = self.row_constants(i);
+                    nb.for_each_lanes_of(i, &[Kind::Fluid], |l| d += self.fluid_weights(&row, l));
                     // A row whose every weight was clipped holds its particle at P = 0.
                     let d = d.reduce_add();
                     if d > 0.0 {
@@ -411,26 +417,27 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
 
 impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
     fn dims(&self) -> [usize; D] {
-        self.nb.grid().dims()
+        self.nb.grid().blocks()
     }
 
     fn aggregate(&self, i: usize) -> Option<usize> {
         match self.roles[i] {
-            Role::Interior => Some(self.nb.grid().cell_of_sorted(i)),
+            Role::Interior => Some(self.nb.grid().block_of_sorted(i)),
             Role::Surface | Role::Splash | Role::Wall | Role::Reference => None,
         }
     }
 
     fn add_coarse_row(&self, i: usize, row: &mut [f64]) {
         let grid = self.nb.grid();
-        let (dims, cell) = (grid.dims(), grid.cell_of_sorted(i));
+        let (dims, cell) = (grid.blocks(), grid.block_of_sorted(i));
         let centre = stencil_slot([0; D]);
         // Interior rows: a_ii = Σ w, a_ij = −w; the other rows are not aggregated.
         if self.roles[i] != Role::Interior {
             return;
         }
-        self.nb.for_each_lanes(i, |l| {
-            let w = self.interior_weights(i, l, l.load(self.fluid_volume));
+        let constants = self.row_constants(i);
+        self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+            let w = self.fluid_weights(&constants, l);
             for (k, w) in w.to_array().into_iter().enumerate() {
                 if w == 0.0 {
                     continue;
@@ -440,7 +447,7 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
                 // A coupling across a periodic boundary joins cells at the two ends of the grid,
                 // outside the 3^D stencil: the coarse levels leave it out (their row keeps its
                 // diagonal), which only weakens the preconditioner near that boundary.
-                let offset = cell_offset(dims, cell, grid.cell_of_sorted(j));
+                let offset = cell_offset(dims, cell, grid.block_of_sorted(j));
                 if self.aggregate(j).is_some() && offset.iter().all(|o| o.abs() <= 1) {
                     row[stencil_slot(offset)] -= w;
                 }

@@ -578,7 +578,7 @@ impl Validator<'_> {
 
     /// `container.periodic`: one flag per axis. A periodic axis must hold a whole number of
     /// particle spacings (the lattice must close on itself) and at least three kernel supports
-    /// (three cells of the cell list, so that a particle never meets two images of another).
+    /// (so that a particle never meets two images of another).
     fn periodic(
         &self,
         flags: Option<&[bool]>,

@@ -179,10 +179,12 @@ impl<const D: usize> Simulation<D> {
     fn sort_by_cell(&mut self) -> Result<(), NumericalFailure> {
         let clock = Instant::now();
         self.grid.wrap(&mut self.particles.pos);
-        if let Err(out) = self
-            .grid
-            .sort(&self.particles.pos, &mut self.cell_of, &mut self.order)
-        {
+        if let Err(out) = self.grid.sort(
+            &self.particles.pos,
+            &self.particles.kind,
+            &mut self.cell_of,
+            &mut self.order,
+        ) {
             let p = &self.particles;
             return Err(NumericalFailure::LeftDomain {
                 id: p.id[out.index],

@@ -111,8 +111,6 @@ pub struct Workspace<const D: usize> {
     /// The wall particle each fluid particle touches (`wall::contact`; its normal is the
     /// wall's).
     contact: Vec<u32>,
-    /// The number of fluid particles up to each index (the wall pressure's dry-wall test).
-    fluid_through: Vec<u32>,
     velocity: [Vec<f64>; D],
     /// Shifting displacement δr of each particle (with shifting).
     shift: [Vec<f64>; D],
@@ -140,7 +138,6 @@ impl<const D: usize> Default for Workspace<D> {
             bicgstab: BiCgStab::default(),
             multigrid: Multigrid::default(),
             contact: Vec::new(),
-            fluid_through: Vec::new(),
             velocity: components(),
             shift: components(),
         }
@@ -240,7 +237,6 @@ impl<const D: usize> Workspace<D> {
             bicgstab,
             multigrid,
             contact,
-            fluid_through,
             velocity,
             shift,
         } = self;
@@ -284,10 +280,6 @@ impl<const D: usize> Workspace<D> {
             (
                 Stage::Corrector,
                 ArraySize::of_components("velocity", velocity),
-            ),
-            (
-                Stage::WallPressure,
-                ArraySize::of("fluid through", fluid_through),
             ),
             (
                 Stage::Shifting,
@@ -552,37 +544,13 @@ impl<const D: usize> Workspace<D> {
 
     /// The pressures of the wall particles, for output and wall loads: the ghost pressures
     /// their fluid neighbours give them (`wall::wall_pressure`), zero where no fluid is in
-    /// reach. Left with the fluid pressures in `self.pressure`. Only the walls some fluid
-    /// reaches cost a pass over their neighbours: a wall particle first checks, from the count
-    /// of fluid particles up to each index (`fluid_through`, the particles sorted by cell),
-    /// whether any of its neighbour ranges holds fluid at all — in a large tank most walls
-    /// are dry.
+    /// reach. Left with the fluid pressures in `self.pressure`. A wall particle visits only its
+    /// fluid neighbours (the fluid and the walls are sorted apart): in a large tank most walls
+    /// are dry, and cost no more than finding their fluid cells empty.
     fn wall_pressure(&mut self, nb: &Neighbours<D>, p: &Particles<D>, gravity: [f64; D]) {
-        self.fluid_through.resize(p.len(), 0);
-        let mut count = 0;
-        for (through, kind) in self.fluid_through.iter_mut().zip(&p.kind) {
-            count += (*kind == Kind::Fluid) as u32;
-            *through = count;
-        }
-        let through = &self.fluid_through;
-        // Fluid particles in the index range [start, end) (end > start).
-        let fluid_in = |start: usize, end: usize| {
-            through[end - 1] - if start > 0 { through[start - 1] } else { 0 }
-        };
         fill(&mut self.pressure, |i| match p.kind[i] {
             Kind::Fluid => p.pressure[i],
-            Kind::Wall => {
-                let mut wet = false;
-                nb.grid()
-                    .for_each_neighbour_range(p.position(i), |range, _| {
-                        wet |= fluid_in(range.start, range.end) > 0;
-                    });
-                if wet {
-                    wall::wall_pressure(nb, p, gravity, i)
-                } else {
-                    0.0
-                }
-            }
+            Kind::Wall => wall::wall_pressure(nb, p, gravity, i),
         });
     }
 

@@ -20,7 +20,7 @@
 //! the wall particles take the wall velocity (zero) plus the fluid particle's own predictor
 //! increment (see `ppe::source`).
 
-use crate::particles::Particles;
+use crate::particles::{Kind, Particles};
 use crate::scene::Aabb;
 use crate::sph::Neighbours;
 
@@ -71,13 +71,11 @@ pub fn wall_pressure<const D: usize>(
     b: usize,
 ) -> f64 {
     let (mut sum, mut weights) = (0.0, 0.0);
-    nb.for_each(b, |f, r_bf, r| {
-        if p.is_fluid(f) {
-            let w = nb.kernel.w(r);
-            let r_fb = r_bf.map(|x| -x);
-            sum += w * (p.pressure[f] + ghost_pressure_difference(p, gravity, f, b, r_fb));
-            weights += w;
-        }
+    nb.for_each_of(b, &[Kind::Fluid], |f, r_bf, r| {
+        let w = nb.kernel.w(r);
+        let r_fb = r_bf.map(|x| -x);
+        sum += w * (p.pressure[f] + ghost_pressure_difference(p, gravity, f, b, r_fb));
+        weights += w;
     });
     if weights > 0.0 {
         sum / weights

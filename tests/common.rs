@@ -62,7 +62,7 @@ impl<const D: usize> Lattice<D> {
             [false; D],
         );
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
-        grid.sort(&particles.pos, &mut cells, &mut order)
+        grid.sort(&particles.pos, &particles.kind, &mut cells, &mut order)
             .expect("lattice inside grid");
         particles.permute(&order, &mut scratch);
         Self {

@@ -13,16 +13,17 @@ fn lcg(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
-/// The cell-list neighbours of n pseudo-random particles in the unit box against a brute-force
-/// search, with the minimum image along the periodic axes (and the pair vector r_ij too).
+/// The cell-list neighbours of n pseudo-random particles in the unit box, a third of them
+/// walls, against a brute-force search, with the minimum image along the periodic axes (and
+/// the pair vector r_ij too); and the neighbours of one kind only.
 fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
     let mut seed = 42;
     let mut p = Particles::<D>::default();
-    for _ in 0..n {
+    for k in 0..n {
         let pos = std::array::from_fn(|_| lcg(&mut seed));
         p.push(NewParticle {
             pos,
-            kind: Kind::Fluid,
+            kind: if k % 3 == 0 { Kind::Wall } else { Kind::Fluid },
             normal: [0.0; D],
             fluid: 0,
             mass: 1.0,
@@ -33,8 +34,11 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
     let kernel = Quintic::<D>::new(h);
     let mut grid = CellList::new([0.0; D], [1.0; D], SUPPORT_IN_H * kernel.h(), periodic);
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
-    grid.sort(&p.pos, &mut cells, &mut order).unwrap();
+    grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);
+    // Sorted by kind: the fluid first, then the walls.
+    let fluid = grid.range_of(Kind::Fluid);
+    assert!(fluid.start == 0 && (0..n).all(|i| p.is_fluid(i) == fluid.contains(&i)));
     let nb = Neighbours::new(&grid, &p.pos, kernel);
     let s2 = kernel.support().powi(2);
     // r_ij with the nearest image of j along the periodic axes.
@@ -57,6 +61,17 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
             .collect();
         let found: Vec<usize> = fast.iter().map(|&(j, _)| j).collect();
         assert_eq!(found, slow, "neighbours of particle {i}");
+        for kind in [Kind::Fluid, Kind::Wall] {
+            let mut of_kind = Vec::new();
+            nb.for_each_of(i, &[kind], |j, _, _| of_kind.push(j));
+            of_kind.sort();
+            let expected: Vec<usize> = slow
+                .iter()
+                .copied()
+                .filter(|&j| p.kind[j] == kind)
+                .collect();
+            assert_eq!(of_kind, expected, "{kind:?} neighbours of particle {i}");
+        }
         for (j, rij) in fast {
             let expected = image(i, j);
             assert!(
@@ -99,13 +114,15 @@ fn sort_keeps_ids_and_reports_particles_outside() {
     }
     let mut grid = CellList::new([0.0; 2], [1.0; 2], 0.1, [false; 2]);
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
-    grid.sort(&p.pos, &mut cells, &mut order).unwrap();
+    grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);
     assert_eq!(p.id, vec![1, 2, 0]);
     assert_eq!(p.pos[0], vec![0.1, 0.5, 0.9]);
     p.pos[0][1] = 7.0;
     assert_eq!(
-        grid.sort(&p.pos, &mut cells, &mut order).unwrap_err().index,
+        grid.sort(&p.pos, &p.kind, &mut cells, &mut order)
+            .unwrap_err()
+            .index,
         1
     );
 }
