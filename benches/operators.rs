@@ -60,33 +60,27 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
     });
 
     g.throughput(Throughput::Elements(setup.pairs(&nb) as u64));
-    let x = p.pressure.clone();
-    let mut y = vec![0.0; n];
+    let x = p.pressure[..op.len()].to_vec();
+    let mut y = vec![0.0; op.len()];
     g.bench_function(label("ppe_apply"), |b| b.iter(|| op.apply(&x, &mut y)));
 
     // A known solution: the hydrostatic pressure under the highest fluid particle.
     let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
-    let top = (0..n)
-        .filter(|&i| p.is_fluid(i))
-        .map(height)
-        .fold(f64::MIN, f64::max);
-    let exact: Vec<f64> = (0..n)
-        .map(|i| {
-            if p.is_fluid(i) {
-                p.rest_density[i] * (top - height(i))
-            } else {
-                0.0
-            }
-        })
+    let top = (0..fluid).map(height).fold(f64::MIN, f64::max);
+    let exact: Vec<f64> = (0..fluid)
+        .map(|i| p.rest_density[i] * (top - height(i)))
         .collect();
-    let mut rhs = vec![0.0; n];
+    let mut rhs = vec![0.0; fluid];
     op.apply(&exact, &mut rhs);
     let params = SolverParams {
         tolerance: scene.solver.tolerance,
         max_iterations: scene.solver.max_iterations,
     };
-    let (mut solver, mut multigrid, mut solution) =
-        (BiCgStab::default(), Multigrid::<D>::default(), vec![0.0; n]);
+    let (mut solver, mut multigrid, mut solution) = (
+        BiCgStab::default(),
+        Multigrid::<D>::default(),
+        vec![0.0; fluid],
+    );
     let info = solver
         .solve(&op, &mut multigrid, &rhs, &mut solution, params)
         .unwrap();

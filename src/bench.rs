@@ -228,8 +228,8 @@ fn time_ppe_apply<const D: usize>(
     let setup = PpeSetup::new(p, kernel);
     let nb = setup.neighbours(p, kernel);
     let op = setup.operator(&nb, p, gravity);
-    let x = p.pressure.clone();
-    let mut y = vec![0.0; p.len()];
+    let x = p.pressure[..op.len()].to_vec();
+    let mut y = vec![0.0; op.len()];
     op.apply(&x, &mut y);
     let seconds = (0..APPLY_REPEATS)
         .map(|_| {
@@ -269,11 +269,10 @@ impl<const D: usize> PpeSetup<D> {
         grid.sort(&p.pos, &p.kind, &mut cells, &mut order)
             .expect("the grid spans the particles' bounding box");
         p.permute(&order, &mut scratch);
-        let mut roles = vec![Role::Wall; p.len()];
-        fill(&mut roles, |i| {
-            Role::from_code(p.kind[i], p.free_surface[i])
-        });
-        let mut row_vectors = std::array::from_fn(|_| vec![0.0; p.len()]);
+        let nf = grid.range_of(Kind::Fluid).end;
+        let mut roles = vec![Role::Interior; nf];
+        fill(&mut roles, |i| Role::from_code(p.free_surface[i]));
+        let mut row_vectors = std::array::from_fn(|_| vec![0.0; nf]);
         let nb = Neighbours::new(&grid, &p.pos, kernel);
         ppe::row_vectors(
             &nb,
@@ -283,7 +282,7 @@ impl<const D: usize> PpeSetup<D> {
             &mut row_vectors,
         );
         let mut fluid_volume = Vec::new();
-        ppe::fluid_volumes(p, &mut fluid_volume);
+        ppe::fluid_volumes(p, nf, &mut fluid_volume);
         Self {
             grid,
             roles,

@@ -3,12 +3,12 @@
 //! counts come from the arrays themselves (`Simulation::arrays`, `Particles::arrays_mut`), so
 //! the plan and the step cannot disagree.
 
+use crate::lattice;
 use crate::scene::{Effects, Scene};
 use crate::simulation::{NoFluid, Simulation};
 use crate::sph::Correction;
 use crate::step;
 use crate::timings::Stage;
-use crate::{lattice, particles::Kind};
 use std::fmt;
 
 /// One stage of the time step.
@@ -17,8 +17,10 @@ pub struct PlannedStage {
     pub stage: Stage,
     /// What it computes, with the scene's constants.
     pub what: String,
-    /// Per-particle bytes of the arrays this stage allocates.
-    pub bytes_per_particle: usize,
+    /// Bytes of the arrays this stage allocates for the scene's particles (each array holds
+    /// every particle or the fluid particles only; the lists of some particles are not
+    /// counted).
+    pub bytes: usize,
 }
 
 #[derive(Clone, Debug)]
@@ -47,21 +49,21 @@ impl Plan {
     fn in_dimension<const D: usize>(scene: &Scene) -> Result<Plan, NoFluid> {
         let mut sim = Simulation::<D>::new(scene)?;
         let arrays = sim.arrays();
+        let fluid = sim.particles.fluid_count();
+        let total = sim.particles.len();
         let stages = step::stages(&scene.effects)
             .into_iter()
             .map(|stage| PlannedStage {
                 stage,
                 what: describe(stage, scene),
-                bytes_per_particle: arrays
+                bytes: arrays
                     .iter()
                     .filter(|(s, _)| *s == stage)
-                    .map(|(_, a)| a.bytes_per_particle)
+                    .map(|(_, a)| a.bytes_per_element * a.elements(total, fluid))
                     .sum(),
             })
             .collect();
-        let p = &mut sim.particles;
-        let fluid = p.kind.iter().filter(|&&k| k == Kind::Fluid).count();
-        let (total, state) = (p.len(), p.arrays_mut());
+        let state = sim.particles.arrays_mut();
         Ok(Plan {
             scene: scene.name.clone(),
             dimensions: D,
@@ -79,14 +81,15 @@ impl Plan {
         self.fluid_particles + self.wall_particles
     }
 
-    /// The particle state and the arrays of every stage.
+    /// Bytes of the particle state and the arrays of every stage.
+    pub fn bytes(&self) -> usize {
+        self.state_bytes_per_particle * self.particles()
+            + self.stages.iter().map(|s| s.bytes).sum::<usize>()
+    }
+
+    /// `bytes` per particle, walls included (rounded).
     pub fn bytes_per_particle(&self) -> usize {
-        self.state_bytes_per_particle
-            + self
-                .stages
-                .iter()
-                .map(|s| s.bytes_per_particle)
-                .sum::<usize>()
+        (self.bytes() as f64 / self.particles() as f64).round() as usize
     }
 }
 
@@ -160,7 +163,8 @@ fn effects_line(e: &Effects) -> String {
 impl fmt::Display for Plan {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         let n = self.particles();
-        let mib = |bytes: usize| (bytes * n) as f64 / (1 << 20) as f64;
+        let mib = |bytes: usize| bytes as f64 / (1 << 20) as f64;
+        let per_particle = |bytes: usize| (bytes as f64 / n as f64).round() as usize;
         writeln!(f, "scene {} ({}D)", self.scene, self.dimensions)?;
         writeln!(
             f,
@@ -173,7 +177,7 @@ impl fmt::Display for Plan {
             "      {:<25} {:>4} B/particle {:>9.2} MiB  position, velocity, wall normal, pressure, density, mass, ρ0, ν, kind, free surface, fluid, id",
             "particle state",
             self.state_bytes_per_particle,
-            mib(self.state_bytes_per_particle),
+            mib(self.state_bytes_per_particle * n),
         )?;
         writeln!(f, "stages per step:")?;
         for (k, s) in self.stages.iter().enumerate() {
@@ -182,16 +186,16 @@ impl fmt::Display for Plan {
                 "  {:>2}. {:<25} {:>4} B/particle {:>9.2} MiB  {}",
                 k + 1,
                 s.stage.name(),
-                s.bytes_per_particle,
-                mib(s.bytes_per_particle),
+                per_particle(s.bytes),
+                mib(s.bytes),
                 s.what
             )?;
         }
-        let total = self.bytes_per_particle();
         write!(
             f,
-            "memory: {total} B/particle, {:.2} MiB for the particle arrays (plus per-cell arrays: the cell list and the multigrid levels)",
-            mib(total)
+            "memory: {} B/particle, {:.2} MiB for the particle arrays (plus per-cell arrays: the cell list and the multigrid levels); the workspace of a step holds the fluid particles only",
+            self.bytes_per_particle(),
+            mib(self.bytes())
         )
     }
 }

@@ -9,8 +9,10 @@
 //!   particle stands for ends. (P_i = 0 at the particle would put the surface half a spacing
 //!   too low and the hydrostatic pressure ρ g dx/2 short everywhere below.)
 //! * splash rows (particles too isolated for a gradient): P_i = 0.
-//! * wall rows: P = 0, a placeholder; the walls' pressures for output are computed after the
-//!   solve from their fluid neighbours (`wall::wall_pressure`).
+//!
+//! The walls have no row: their pressures for output are computed after the solve from their
+//! fluid neighbours (`wall::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
+//! first in the sorted order).
 
 use crate::free_surface::Support;
 use crate::linsolve::LinearOperator;
@@ -32,8 +34,6 @@ pub enum Role {
     Surface,
     /// Fluid too isolated to have a pressure gradient (spray, drops): P = 0.
     Splash,
-    /// Wall particle: no unknown.
-    Wall,
     /// The one fluid particle pinned to P = 0 where the fluid has no free surface at all (a
     /// closed or periodic box), whose PPE fixes the pressure only up to a constant.
     Reference,
@@ -46,36 +46,29 @@ impl Role {
     }
 
     /// The role's code in the frames' `free_surface` dataset (`Particles::free_surface`):
-    /// 1 free surface, 2 splash, 0 interior or wall.
+    /// 1 free surface, 2 splash, 0 interior (walls have 0 too).
     pub fn code(self) -> u8 {
         match self {
             Role::Surface => 1,
             Role::Splash => 2,
-            Role::Interior | Role::Wall | Role::Reference => 0,
+            Role::Interior | Role::Reference => 0,
         }
     }
 
-    /// The role of a particle of `kind` whose `free_surface` code is `code` (see `code`).
-    pub fn from_code(kind: Kind, code: u8) -> Role {
-        match (kind, code) {
-            (Kind::Wall, _) => Role::Wall,
-            (Kind::Fluid, 1) => Role::Surface,
-            (Kind::Fluid, 2) => Role::Splash,
-            (Kind::Fluid, _) => Role::Interior,
+    /// The role of a fluid particle whose `free_surface` code is `code` (see `code`).
+    pub fn from_code(code: u8) -> Role {
+        match code {
+            1 => Role::Surface,
+            2 => Role::Splash,
+            _ => Role::Interior,
         }
     }
 }
 
-/// V_i = m_i/ρ0_i of fluid particles, zero for walls: the volumes the PPE rows couple.
-pub fn fluid_volumes<const D: usize>(p: &Particles<D>, out: &mut Vec<f64>) {
-    out.resize(p.len(), 0.0);
-    fill(out, |i| {
-        if p.is_fluid(i) {
-            p.mass[i] / p.rest_density[i]
-        } else {
-            0.0
-        }
-    });
+/// V_i = m_i/ρ0_i of the `nf` fluid particles: the volumes the PPE rows couple.
+pub fn fluid_volumes<const D: usize>(p: &Particles<D>, nf: usize, out: &mut Vec<f64>) {
+    out.resize(nf, 0.0);
+    fill(out, |i| p.mass[i] / p.rest_density[i]);
 }
 
 /// The role of particle i: fluid on the free surface (see `free_surface`) takes the surface
@@ -83,23 +76,20 @@ pub fn fluid_volumes<const D: usize>(p: &Particles<D>, out: &mut Vec<f64>) {
 /// matrix of its pressure gradient is near-singular, whether or not the scene applies the
 /// kernel correction). Fluid that fills its container (`confined`) has no free surface: every
 /// fluid row is interior (a disordered patch of a periodic flow can look like a surface to the
-/// detection). `support` is None for walls.
+/// detection).
 pub fn role<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    support: Option<&Support<D>>,
+    support: &Support<D>,
     gradient_defined: bool,
     confined: bool,
     i: usize,
 ) -> Role {
-    let Some(support) = support else {
-        return Role::Wall;
-    };
     if confined {
         return Role::Interior;
     }
     let mut fluid_neighbours = 0;
-    nb.for_each(i, |j, _, _| fluid_neighbours += p.is_fluid(j) as usize);
+    nb.for_each_of(i, &[Kind::Fluid], |_, _, _| fluid_neighbours += 1);
     if fluid_neighbours == 0 || !gradient_defined {
         Role::Splash
     } else if support.is_free_surface(nb, i, p.density[i] / p.rest_density[i]) {
@@ -121,7 +111,7 @@ pub fn pin_reference<const D: usize>(
         return None;
     }
     let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
-    let top = (0..p.len())
+    let top = (0..roles.len())
         .filter(|&i| roles[i] == Role::Interior)
         .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)))?;
     roles[top] = Role::Reference;
@@ -137,7 +127,7 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
             return false;
         }
         let mut any_free = false;
-        nb.for_each(i, |j, _, _| any_free |= roles[j].is_free());
+        nb.for_each_of(i, &[Kind::Fluid], |j, _, _| any_free |= roles[j].is_free());
         !any_free
     });
 }
@@ -157,7 +147,7 @@ pub fn row_vectors<const D: usize>(
 ) {
     fill_vector(out, |i| match roles[i] {
         Role::Interior => laplacian_correction(nb, p, pressure_corrections.of(i), i),
-        Role::Surface | Role::Splash | Role::Wall | Role::Reference => [0.0; D],
+        Role::Surface | Role::Splash | Role::Reference => [0.0; D],
     });
 }
 
@@ -187,14 +177,14 @@ pub fn source<const D: usize>(
 ) {
     let (nb, p) = (op.nb, op.p);
     let g = op.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
-    b.resize(p.len(), 0.0);
+    b.resize(op.roles.len(), 0.0);
     fill(b, |i| match op.roles[i] {
         Role::Interior => {
             divergence_source(nb, p, corrections.of(i), u_star, full[i], dt, alpha, i)
                 + op.wall_source(i)
         }
         Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
-        Role::Splash | Role::Wall | Role::Reference => 0.0,
+        Role::Splash | Role::Reference => 0.0,
     });
 }
 
@@ -301,8 +291,7 @@ pub struct PressureOperator<'a, const D: usize> {
     pub roles: &'a [Role],
     /// The row vectors of `row_vectors`.
     pub row_vectors: &'a [Vec<f64>; D],
-    /// V_j = m_j/ρ0_j of fluid particles, zero for walls: the unknowns the rows couple
-    /// (`fluid_volumes`).
+    /// V_j = m_j/ρ0_j of the fluid particles, the unknowns the rows couple (`fluid_volumes`).
     pub fluid_volume: &'a [f64],
     pub gravity: [f64; D],
 }
@@ -379,14 +368,14 @@ impl<const D: usize> PressureOperator<'_, D> {
                 });
                 ax.reduce_add()
             }
-            Role::Surface | Role::Splash | Role::Wall | Role::Reference => x[i],
+            Role::Surface | Role::Splash | Role::Reference => x[i],
         }
     }
 }
 
 impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
     fn len(&self) -> usize {
-        self.p.len()
+        self.roles.len()
     }
 
     fn apply(&self, x: &[f64], y: &mut [f64]) {
@@ -409,7 +398,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
                         1.0
                     }
                 }
-                Role::Surface | Role::Splash | Role::Wall | Role::Reference => 1.0,
+                Role::Surface | Role::Splash | Role::Reference => 1.0,
             }
         })
     }
@@ -423,7 +412,7 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
     fn aggregate(&self, i: usize) -> Option<usize> {
         match self.roles[i] {
             Role::Interior => Some(self.nb.grid().block_of_sorted(i)),
-            Role::Surface | Role::Splash | Role::Wall | Role::Reference => None,
+            Role::Surface | Role::Splash | Role::Reference => None,
         }
     }
 

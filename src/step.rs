@@ -4,14 +4,16 @@
 //! The stages of the effects a scene turns off (`scene::Effects`) are skipped. Each stage reads
 //! the particles and writes its own workspace arrays, which it allocates when it first runs and
 //! reuses after, so the arrays of a stage that does not run are never allocated
-//! (`Workspace::arrays` lists them all by stage). The step swaps the new velocity, pressure and
-//! density into the particles.
+//! (`Workspace::arrays` lists them all by stage). The fluid particles come first in the sorted
+//! order (`grid`), and every workspace array holds the fluid particles only: the walls are
+//! fixed, hold no unknown and need none of them. The step copies the new velocity, pressure
+//! and density of the fluid into the particles.
 
 use crate::free_surface::Support;
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::linsolve::{BiCgStab, SolveInfo, SolverError, SolverParams};
-use crate::memory::ArraySize;
+use crate::memory::{ArraySize, Holds};
 use crate::multigrid::Multigrid;
 use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
@@ -84,8 +86,6 @@ pub struct Workspace<const D: usize> {
     /// The particle pinned to P = 0 where the fluid has no free surface (`ppe::pin_reference`;
     /// None: the fluid has one, its pressure is absolute and cannot hold a tension).
     reference: Option<usize>,
-    /// The role of each particle as written to the frames (`Particles::free_surface`).
-    free_surface: Vec<u8>,
     /// No free-surface particle in the kernel support.
     full_support: Vec<bool>,
     /// Kernel gradient correction L_i of each particle, Eq. (25) (with the kernel correction).
@@ -123,7 +123,6 @@ impl<const D: usize> Default for Workspace<D> {
             surface_normal: Vec::new(),
             roles: Vec::new(),
             reference: None,
-            free_surface: Vec::new(),
             full_support: Vec::new(),
             corrections: Vec::new(),
             correction_slot: Vec::new(),
@@ -157,6 +156,9 @@ impl<const D: usize> Workspace<D> {
         timings: &mut Timings,
     ) -> Result<StepReport, SolverError> {
         let effects = &set.effects;
+        let fluid = grid.range_of(Kind::Fluid);
+        debug_assert_eq!(fluid.start, 0, "the fluid comes first in the sorted order");
+        let nf = fluid.end;
         let report = {
             let nb = Neighbours::new(grid, &p.pos, kernel);
             let mut clock = Instant::now();
@@ -168,11 +170,12 @@ impl<const D: usize> Workspace<D> {
                 }
                 clock = now;
             };
-            self.summation_density(&nb, p);
-            std::mem::swap(&mut p.density, &mut self.density);
+            self.summation_density(&nb, p, nf);
+            p.density[..nf].copy_from_slice(&self.density);
             lap(Stage::Density);
-            self.classify(&nb, p, set);
-            std::mem::swap(&mut p.free_surface, &mut self.free_surface);
+            self.classify(&nb, p, set, nf);
+            let roles = &self.roles;
+            fill(&mut p.free_surface[..nf], |i| roles[i].code());
             lap(Stage::FreeSurface);
             if effects.kernel_correction {
                 self.near_surface_corrections(&nb, p);
@@ -185,21 +188,25 @@ impl<const D: usize> Workspace<D> {
             self.predict(&nb, p, set, dt);
             lap(Stage::Predictor);
             let solve = self.solve_pressure(&nb, p, set, dt)?;
-            let clip = self.reference.is_none();
-            fill(&mut p.pressure, |i| cavitation(clip, self.pressure[i]));
+            let (clip, pressure) = (self.reference.is_none(), &self.pressure);
+            fill(&mut p.pressure[..nf], |i| cavitation(clip, pressure[i]));
             lap(Stage::PressureSolve);
             self.correct(&nb, p, set, dt);
-            std::mem::swap(&mut p.vel, &mut self.velocity);
+            copy_vector(&self.velocity, &mut p.vel);
             lap(Stage::Corrector);
             let (density_error, disorder) = self.full_support_statistics(&nb, p);
             lap(Stage::Diagnostics);
-            self.wall_pressure(&nb, p, set.gravity);
-            std::mem::swap(&mut p.pressure, &mut self.pressure);
+            let ghosts = wall::Ghosts {
+                rest_density: &p.rest_density,
+                normal: &p.normal,
+                gravity: set.gravity,
+            };
+            wall_pressure(&nb, &ghosts, &mut p.pressure, nf);
             lap(Stage::WallPressure);
             if let Some(shifting) = &effects.shifting {
                 self.shift(&nb, p, set, shifting, dt);
-                std::mem::swap(&mut p.vel, &mut self.velocity);
-                std::mem::swap(&mut p.pressure, &mut self.pressure);
+                copy_vector(&self.velocity, &mut p.vel);
+                p.pressure[..nf].copy_from_slice(&self.pressure);
                 lap(Stage::Shifting);
             }
             StepReport {
@@ -209,7 +216,7 @@ impl<const D: usize> Workspace<D> {
             }
         };
         let clock = Instant::now();
-        self.advect(p, dt, effects.shifting.is_some());
+        self.advect(p, nf, dt, effects.shifting.is_some());
         timings.add(Stage::Advection, clock.elapsed());
         Ok(report)
     }
@@ -222,7 +229,6 @@ impl<const D: usize> Workspace<D> {
             surface_normal,
             roles,
             reference: _,
-            free_surface,
             full_support,
             corrections,
             correction_slot,
@@ -243,10 +249,6 @@ impl<const D: usize> Workspace<D> {
         let mut arrays = vec![
             (Stage::Density, ArraySize::of("density", density)),
             (Stage::FreeSurface, ArraySize::of("PPE role", roles)),
-            (
-                Stage::FreeSurface,
-                ArraySize::of("free surface", free_surface),
-            ),
             (
                 Stage::FreeSurface,
                 ArraySize::of("full support", full_support),
@@ -289,26 +291,28 @@ impl<const D: usize> Workspace<D> {
         ];
         let solver = bicgstab.arrays().into_iter().chain(multigrid.fine_arrays());
         arrays.extend(solver.map(|a| (Stage::PressureSolve, a)));
+        // Every array of the workspace holds the fluid particles only (see the module doc).
+        for (_, a) in &mut arrays {
+            if a.holds == Holds::EveryParticle {
+                *a = a.clone().fluid();
+            }
+        }
         arrays
     }
 
-    /// Summation density; walls keep their rest density.
-    fn summation_density(&mut self, nb: &Neighbours<D>, p: &Particles<D>) {
-        self.density.resize(p.len(), 0.0);
-        fill(&mut self.density, |i| match p.kind[i] {
-            Kind::Fluid => sph::density(nb, p, i),
-            Kind::Wall => p.rest_density[i],
-        });
+    /// Summation density of the `nf` fluid particles (walls keep their rest density).
+    fn summation_density(&mut self, nb: &Neighbours<D>, p: &Particles<D>, nf: usize) {
+        self.density.resize(nf, 0.0);
+        fill(&mut self.density, |i| sph::density(nb, p, i));
     }
 
     /// How each support is filled, from its moments (`sph::support_moments`): the free surface
     /// and the role of each particle in the PPE (`ppe::role`), and with shifting the surface
     /// normal. With the kernel correction the corrections L_i and L'_i of Eq. (25) are inverted
     /// here from the same moments, once per step for every operator below.
-    fn classify(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>) {
-        let n = p.len();
-        self.roles.resize(n, Role::Wall);
-        self.free_surface.resize(n, 0);
+    fn classify(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, nf: usize) {
+        let n = nf;
+        self.roles.resize(n, Role::Interior);
         let corrections = if set.effects.kernel_correction {
             self.pressure_corrections.resize(n, None);
             Either::Left(self.pressure_corrections.par_iter_mut().map(Some))
@@ -327,19 +331,12 @@ impl<const D: usize> Workspace<D> {
             .zip(corrections)
             .enumerate()
             .for_each(|(i, ((role, normal), corrections))| {
-                let mo = p.is_fluid(i).then(|| sph::support_moments(nb, p, i));
-                let l_pressure = mo.and_then(|mo| sph::gradient_correction(mo.m_neumann));
-                let support = mo.map(|mo| Support::new(&mo.m, mo.grad_c));
-                *role = ppe::role(
-                    nb,
-                    p,
-                    support.as_ref(),
-                    l_pressure.is_some(),
-                    set.confined,
-                    i,
-                );
+                let mo = sph::support_moments(nb, p, i);
+                let l_pressure = sph::gradient_correction(mo.m_neumann);
+                let support = Support::new(&mo.m, mo.grad_c);
+                *role = ppe::role(nb, p, &support, l_pressure.is_some(), set.confined, i);
                 if let Some(normal) = normal {
-                    *normal = support.map_or([0.0; D], |s| s.normal);
+                    *normal = support.normal;
                 }
                 if let Some(lp) = corrections {
                     *lp = l_pressure;
@@ -347,7 +344,6 @@ impl<const D: usize> Workspace<D> {
             });
         self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
         ppe::full_support(nb, &self.roles, &mut self.full_support);
-        fill(&mut self.free_surface, |i| self.roles[i].code());
     }
 
     /// Inside the fluid (no free surface in reach) the moment matrix measures the disorder of
@@ -359,10 +355,11 @@ impl<const D: usize> Workspace<D> {
     /// gradient keeps its correction L'_i everywhere, which inside the fluid corrects the wall
     /// ghosts' missing tangential gradient.
     fn near_surface_corrections(&mut self, nb: &Neighbours<D>, p: &Particles<D>) {
-        self.correction_slot.resize(p.len(), NO_SLOT);
+        self.correction_slot
+            .resize(self.full_support.len(), NO_SLOT);
         self.corrected.clear();
         for (i, slot) in self.correction_slot.iter_mut().enumerate() {
-            *slot = if p.is_fluid(i) && !self.full_support[i] {
+            *slot = if !self.full_support[i] {
                 self.corrected.push(i as u32);
                 (self.corrected.len() - 1) as u32
             } else {
@@ -386,17 +383,14 @@ impl<const D: usize> Workspace<D> {
         set: &StepSettings<D>,
         les: &LesSettings,
     ) {
-        self.eddy.resize(p.len(), 0.0);
+        self.eddy.resize(self.roles.len(), 0.0);
         let corrections = Corrections::sparse(
             set.effects.kernel_correction,
             &self.correction_slot,
             &self.corrections,
         );
-        fill(&mut self.eddy, |i| match p.kind[i] {
-            Kind::Fluid => {
-                turbulence::eddy_viscosity(nb, p, corrections.of(i), les.cs, set.spacing, i)
-            }
-            Kind::Wall => 0.0,
+        fill(&mut self.eddy, |i| {
+            turbulence::eddy_viscosity(nb, p, corrections.of(i), les.cs, set.spacing, i)
         });
     }
 
@@ -405,30 +399,27 @@ impl<const D: usize> Workspace<D> {
     /// its wall function); walls stay at rest.
     fn predict(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
         for a in &mut self.u_star {
-            a.resize(p.len(), 0.0);
+            a.resize(self.roles.len(), 0.0);
         }
         let (spacing, gravity, les) = (set.spacing, set.gravity, set.effects.les);
         let eddy = les.is_some().then_some(&self.eddy[..]);
         let wall_function = les.is_some_and(|les| les.wall_function);
         let support = nb.kernel.support();
-        fill_vector(&mut self.u_star, |i| match p.kind[i] {
-            Kind::Fluid => {
-                // The nearest wall, for the no-slip wall velocity and the wall function.
-                let face = wall::nearest_face(nb, p, spacing, support, i);
-                let visc = sph::viscous_acceleration(nb, p, eddy, face, i);
-                let wall = if wall_function {
-                    turbulence::wall_shear(p, spacing, face, i)
-                } else {
-                    [0.0; D]
-                };
-                std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + wall[d] + gravity[d]))
-            }
-            Kind::Wall => [0.0; D],
+        fill_vector(&mut self.u_star, |i| {
+            // The nearest wall, for the no-slip wall velocity and the wall function.
+            let face = wall::nearest_face(nb, p, spacing, support, i);
+            let visc = sph::viscous_acceleration(nb, p, eddy, face, i);
+            let wall = if wall_function {
+                turbulence::wall_shear(p, spacing, face, i)
+            } else {
+                [0.0; D]
+            };
+            std::array::from_fn(|d| p.vel[d][i] + dt * (visc[d] + wall[d] + gravity[d]))
         });
     }
 
-    /// PPE, Eq. (6), solved by BiCGSTAB from the last pressure (warm start; walls hold no
-    /// unknown). The solution is left in `self.pressure`.
+    /// PPE, Eq. (6), solved by BiCGSTAB from the last pressure (warm start; the unknowns are
+    /// the fluid pressures, walls hold none). The solution is left in `self.pressure`.
     fn solve_pressure(
         &mut self,
         nb: &Neighbours<D>,
@@ -436,7 +427,7 @@ impl<const D: usize> Workspace<D> {
         set: &StepSettings<D>,
         dt: f64,
     ) -> Result<SolveInfo, SolverError> {
-        let n = p.len();
+        let n = self.roles.len();
         for a in &mut self.row_vectors {
             a.resize(n, 0.0);
         }
@@ -449,7 +440,7 @@ impl<const D: usize> Workspace<D> {
             Corrections::new(kernel_correction, &self.pressure_corrections),
             &mut self.row_vectors,
         );
-        ppe::fluid_volumes(p, &mut self.fluid_volume);
+        ppe::fluid_volumes(p, n, &mut self.fluid_volume);
         let op = PressureOperator {
             nb,
             p,
@@ -476,7 +467,7 @@ impl<const D: usize> Workspace<D> {
         let level = self.reference.map_or(0.0, |r| p.pressure[r]);
         fill(&mut self.pressure, |i| match roles[i] {
             Role::Interior | Role::Surface => p.pressure[i] - level,
-            Role::Splash | Role::Wall | Role::Reference => 0.0,
+            Role::Splash | Role::Reference => 0.0,
         });
         let info = self.bicgstab.solve(
             &op,
@@ -494,25 +485,20 @@ impl<const D: usize> Workspace<D> {
     /// Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls
     /// as ghosts; particles touching a wall keep no velocity into it (`wall::no_penetration`).
     fn correct(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, dt: f64) {
+        let n = self.roles.len();
         for a in &mut self.velocity {
-            a.resize(p.len(), 0.0);
+            a.resize(n, 0.0);
         }
-        self.contact.resize(p.len(), wall::NO_CONTACT);
-        fill(&mut self.contact, |i| match p.kind[i] {
-            Kind::Fluid => wall::contact(nb, p, set.spacing, i),
-            Kind::Wall => wall::NO_CONTACT,
-        });
+        self.contact.resize(n, wall::NO_CONTACT);
+        fill(&mut self.contact, |i| wall::contact(nb, p, set.spacing, i));
         let (u_star, contact) = (&self.u_star, &self.contact);
         let corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
-        fill_vector(&mut self.velocity, |i| match p.kind[i] {
-            Kind::Fluid => {
-                let grad = pressure_gradient(nb, p, set.gravity, corrections.of(i), i);
-                let rho0 = p.rest_density[i];
-                let u = std::array::from_fn(|d| u_star[d][i] - dt * grad[d] / rho0);
-                wall::no_penetration(u, wall::contact_normal(p, contact[i]))
-            }
-            Kind::Wall => [0.0; D],
+        fill_vector(&mut self.velocity, |i| {
+            let grad = pressure_gradient(nb, p, set.gravity, corrections.of(i), i);
+            let rho0 = p.rest_density[i];
+            let u = std::array::from_fn(|d| u_star[d][i] - dt * grad[d] / rho0);
+            wall::no_penetration(u, wall::contact_normal(p, contact[i]))
         });
     }
 
@@ -525,7 +511,7 @@ impl<const D: usize> Workspace<D> {
     ///   (tensile instability, no shifting).
     fn full_support_statistics(&self, nb: &Neighbours<D>, p: &Particles<D>) -> (f64, f64) {
         let full = &self.full_support;
-        let [count, density, distance, square] = reduce::sums(p.len(), |i| {
+        let [count, density, distance, square] = reduce::sums(full.len(), |i| {
             if !full[i] {
                 return [0.0; 4];
             }
@@ -542,18 +528,6 @@ impl<const D: usize> Workspace<D> {
         (density / count, variance.sqrt() / mean)
     }
 
-    /// The pressures of the wall particles, for output and wall loads: the ghost pressures
-    /// their fluid neighbours give them (`wall::wall_pressure`), zero where no fluid is in
-    /// reach. Left with the fluid pressures in `self.pressure`. A wall particle visits only its
-    /// fluid neighbours (the fluid and the walls are sorted apart): in a large tank most walls
-    /// are dry, and cost no more than finding their fluid cells empty.
-    fn wall_pressure(&mut self, nb: &Neighbours<D>, p: &Particles<D>, gravity: [f64; D]) {
-        fill(&mut self.pressure, |i| match p.kind[i] {
-            Kind::Fluid => p.pressure[i],
-            Kind::Wall => wall::wall_pressure(nb, p, gravity, i),
-        });
-    }
-
     /// Particle shifting δr = −D ∇C (Eq. 10) at rⁿ, then velocity and pressure carried to the
     /// shifted position by Eq. (9); the new velocity and pressure are left in `self.velocity`
     /// and `self.pressure`.
@@ -565,10 +539,11 @@ impl<const D: usize> Workspace<D> {
         settings: &ShiftingSettings,
         dt: f64,
     ) {
+        let n = self.roles.len();
         for a in &mut self.shift {
-            a.resize(p.len(), 0.0);
+            a.resize(n, 0.0);
         }
-        let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
+        let max_speed = reduce::max(n, |i| speed(p, i));
         let shifting = Shifting::new(nb, settings, set.spacing, max_speed, dt);
         let (roles, normals, full, contact) = (
             &self.roles,
@@ -583,7 +558,7 @@ impl<const D: usize> Workspace<D> {
                 let dr = shifting.displacement(nb, p, normals[i], full[i], i);
                 wall::no_penetration(dr, wall::contact_normal(p, contact[i]))
             }
-            Role::Splash | Role::Wall => [0.0; D],
+            Role::Splash => [0.0; D],
         });
         let shift = &self.shift;
         let corrections = Corrections::sparse(
@@ -591,58 +566,71 @@ impl<const D: usize> Workspace<D> {
             &self.correction_slot,
             &self.corrections,
         );
-        fill_vector(&mut self.velocity, |i| match p.kind[i] {
-            Kind::Fluid => {
-                // Where the free surface is in reach the velocity gradient is no longer that of
-                // a filled support, and shifting moves particles into the thinning, faster parts
-                // of a stretching flow: the Taylor step there feeds the flow energy (measured).
-                if !full[i] {
-                    return p.velocity(i);
-                }
-                let g = sph::velocity_gradient(
-                    nb,
-                    p,
-                    corrections.of(i),
-                    |j| sph::fluid_velocity(p, i, j),
-                    i,
-                );
-                let dr = vector(shift, i);
-                std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
+        fill_vector(&mut self.velocity, |i| {
+            // Where the free surface is in reach the velocity gradient is no longer that of a
+            // filled support, and shifting moves particles into the thinning, faster parts of a
+            // stretching flow: the Taylor step there feeds the flow energy (measured).
+            if !full[i] {
+                return p.velocity(i);
             }
-            Kind::Wall => [0.0; D],
+            let g = sph::velocity_gradient(
+                nb,
+                p,
+                corrections.of(i),
+                |j| sph::fluid_velocity(p, i, j),
+                i,
+            );
+            let dr = vector(shift, i);
+            std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
         });
         let pressure_corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         let clip = self.reference.is_none();
-        fill(&mut self.pressure, |i| match p.kind[i] {
-            Kind::Fluid => {
-                let g = pressure_gradient(nb, p, set.gravity, pressure_corrections.of(i), i);
-                let dr = vector(shift, i);
-                cavitation(
-                    clip,
-                    p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>(),
-                )
-            }
-            Kind::Wall => p.pressure[i],
+        fill(&mut self.pressure, |i| {
+            let g = pressure_gradient(nb, p, set.gravity, pressure_corrections.of(i), i);
+            let dr = vector(shift, i);
+            cavitation(
+                clip,
+                p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>(),
+            )
         });
     }
 
-    /// Advection, Eq. (8), plus the shift of the step when shifting ran.
-    fn advect(&self, p: &mut Particles<D>, dt: f64, shifted: bool) {
+    /// Advection, Eq. (8), of the `nf` fluid particles, plus the shift of the step when
+    /// shifting ran.
+    fn advect(&self, p: &mut Particles<D>, nf: usize, dt: f64, shifted: bool) {
         for d in 0..D {
-            let (kind, vel, shift) = (&p.kind, &p.vel[d], &self.shift[d]);
-            p.pos[d]
+            let (vel, shift) = (&p.vel[d], &self.shift[d]);
+            p.pos[d][..nf]
                 .par_iter_mut()
-                .zip(vel)
-                .zip(kind)
                 .enumerate()
-                .for_each(|(i, ((x, v), k))| {
-                    if *k == Kind::Fluid {
-                        let s = if shifted { shift[i] } else { 0.0 };
-                        *x += dt * v + s;
-                    }
+                .for_each(|(i, x)| {
+                    let s = if shifted { shift[i] } else { 0.0 };
+                    *x += dt * vel[i] + s;
                 });
         }
+    }
+}
+
+/// The pressures of the wall particles (from index `nf` on), for output and wall loads: the
+/// ghost pressures their fluid neighbours give them (`wall::wall_pressure`), zero where no fluid
+/// is in reach. A wall particle visits only its fluid neighbours (the fluid and the walls are
+/// sorted apart): in a large tank most walls are dry, and cost no more than finding their fluid
+/// cells empty.
+fn wall_pressure<const D: usize>(
+    nb: &Neighbours<D>,
+    ghosts: &wall::Ghosts<D>,
+    pressure: &mut [f64],
+    nf: usize,
+) {
+    let (fluid, walls) = pressure.split_at_mut(nf);
+    fill(walls, |k| ghosts.wall_pressure(nb, fluid, nf + k));
+}
+
+/// `to[d][..n] = from[d]` for each component, n the length of `from`.
+fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
+    for (f, t) in from.iter().zip(to) {
+        t[..f.len()].copy_from_slice(f);
     }
 }
 
@@ -677,20 +665,12 @@ fn cavitation(clip: bool, pressure: f64) -> f64 {
 /// PPE fixes them only up to a constant, and a pressure level that does not depend on which
 /// particle happened to be the reference keeps the frames comparable.
 fn zero_mean_pressure<const D: usize>(p: &Particles<D>, pressure: &mut [f64]) {
-    let [volume, integral] = reduce::sums(p.len(), |i| {
-        if p.is_fluid(i) {
-            let v = p.mass[i] / p.rest_density[i];
-            [v, v * pressure[i]]
-        } else {
-            [0.0; 2]
-        }
+    let [volume, integral] = reduce::sums(pressure.len(), |i| {
+        let v = p.mass[i] / p.rest_density[i];
+        [v, v * pressure[i]]
     });
     let mean = integral / volume;
-    pressure.par_iter_mut().zip(&p.kind).for_each(|(x, &kind)| {
-        if kind == Kind::Fluid {
-            *x -= mean;
-        }
-    });
+    pressure.par_iter_mut().for_each(|x| *x -= mean);
 }
 
 /// Component vector i of a SoA vector field.

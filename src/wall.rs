@@ -62,25 +62,35 @@ pub fn ghost_velocity<const D: usize>(
     std::array::from_fn(|d| u_i[d] - across[d])
 }
 
-/// Pressure of wall particle b for output and wall loads: the kernel-weighted mean of the ghost
-/// pressures its fluid neighbours give it (zero where no fluid is in reach).
-pub fn wall_pressure<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    gravity: [f64; D],
-    b: usize,
-) -> f64 {
-    let (mut sum, mut weights) = (0.0, 0.0);
-    nb.for_each_of(b, &[Kind::Fluid], |f, r_bf, r| {
-        let w = nb.kernel.w(r);
-        let r_fb = r_bf.map(|x| -x);
-        sum += w * (p.pressure[f] + ghost_pressure_difference(p, gravity, f, b, r_fb));
-        weights += w;
-    });
-    if weights > 0.0 {
-        sum / weights
-    } else {
-        0.0
+/// What the ghost pressures of the walls are made of, borrowed apart from the pressures
+/// themselves (the wall pressure is written beside the fluid's it is computed from).
+pub struct Ghosts<'a, const D: usize> {
+    pub rest_density: &'a [f64],
+    pub normal: &'a [Vec<f64>; D],
+    pub gravity: [f64; D],
+}
+
+impl<const D: usize> Ghosts<'_, D> {
+    /// Pressure of wall particle b for output and wall loads: the kernel-weighted mean of the
+    /// ghost pressures its fluid neighbours give it (zero where no fluid is in reach), with
+    /// `fluid_pressure` the pressures of the fluid particles.
+    pub fn wall_pressure(&self, nb: &Neighbours<D>, fluid_pressure: &[f64], b: usize) -> f64 {
+        let (mut sum, mut weights) = (0.0, 0.0);
+        nb.for_each_of(b, &[Kind::Fluid], |f, r_bf, r| {
+            let w = nb.kernel.w(r);
+            // P_b − P_f = −ρ0 g·N_b r_fb (see the module doc), r_fb = −r_bf.
+            let across: f64 = (0..D)
+                .filter(|&d| self.normal[d][b] != 0.0)
+                .map(|d| self.gravity[d] * r_bf[d])
+                .sum();
+            sum += w * (fluid_pressure[f] + self.rest_density[f] * across);
+            weights += w;
+        });
+        if weights > 0.0 {
+            sum / weights
+        } else {
+            0.0
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 //! refused, and a scene without `[effects]` runs as before.
 
 use crate::common::{run_scene, water_block_scene, TempDir};
+use isph::memory::Holds;
 use isph::plan::Plan;
 use isph::scene::Scene;
 use isph::simulation::Simulation;
@@ -53,12 +54,21 @@ fn check_plan_against_a_step(scene: &Scene) -> Vec<Stage> {
     }
 
     let arrays = sim.arrays();
+    let fluid = sim.particles.fluid_count();
     for (stage, a) in &arrays {
         if planned.contains(stage) {
-            // A sparse list (some particles only) may be empty; a per-particle array is full.
-            if a.per_particle {
-                assert_eq!(a.len, n, "{} ({}) not allocated", a.name, stage.name());
-                assert!(a.allocated >= n * a.bytes_per_particle, "{}", a.name);
+            // A sparse list (some particles only) may be empty; an array of every particle or
+            // of every fluid particle is full.
+            let elements = a.elements(n, fluid);
+            if a.holds != Holds::Some {
+                assert_eq!(
+                    a.len,
+                    elements,
+                    "{} ({}) not allocated",
+                    a.name,
+                    stage.name()
+                );
+                assert!(a.allocated >= elements * a.bytes_per_element, "{}", a.name);
             }
         } else {
             assert_eq!(
@@ -73,10 +83,10 @@ fn check_plan_against_a_step(scene: &Scene) -> Vec<Stage> {
     for s in &plan.stages {
         let allocated: usize = arrays
             .iter()
-            .filter(|(stage, a)| *stage == s.stage && a.len == n)
-            .map(|(_, a)| a.bytes_per_particle)
+            .filter(|(stage, a)| *stage == s.stage && a.holds != Holds::Some)
+            .map(|(_, a)| a.len * a.bytes_per_element)
             .sum();
-        assert_eq!(allocated, s.bytes_per_particle, "{}", s.stage.name());
+        assert_eq!(allocated, s.bytes, "{}", s.stage.name());
     }
     planned
 }
@@ -160,7 +170,10 @@ fn the_plan_prints_the_stages_in_order_with_their_memory() {
         let planned: Vec<(String, usize)> = plan
             .stages
             .iter()
-            .map(|s| (s.stage.name().to_string(), s.bytes_per_particle))
+            .map(|s| {
+                let per_particle = (s.bytes as f64 / plan.particles() as f64).round() as usize;
+                (s.stage.name().to_string(), per_particle)
+            })
             .collect();
         assert_eq!(printed, planned, "{text}");
         let total = format!("memory: {} B/particle", plan.bytes_per_particle());
