@@ -159,6 +159,13 @@ impl<const D: usize> CellList<D> {
         lin
     }
 
+    /// The block along axis d of coordinate x (of a point inside the grid), as
+    /// `block_of_sorted` counts them.
+    #[inline]
+    pub fn block_along(&self, d: usize, x: f64) -> i64 {
+        self.cell_along(d, x) / subdivision(d) as i64
+    }
+
     /// The per-particle array of the grid: the cell of each particle in the sorted order.
     pub fn sorted_cells(&self) -> ArraySize {
         ArraySize::of("cell of sorted particle", &self.sorted_cell)

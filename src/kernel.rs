@@ -65,6 +65,22 @@ impl<const D: usize> Quintic<D> {
         }
     }
 
+    /// W(r) in lanes.
+    #[inline(always)]
+    pub fn w4(&self, r: f64x4) -> f64x4 {
+        let [a, b, c] = self.spline_terms4(r);
+        let p5 = |x: f64x4| (x * x) * (x * x) * x;
+        f64x4::splat(self.norm)
+            * f64x4::splat(15.0).mul_add(p5(c), f64x4::splat(-6.0).mul_add(p5(b), p5(a)))
+    }
+
+    /// F(r) = W'(r)/r in lanes (W''(0) where r = 0, as `grad_factor`).
+    #[inline(always)]
+    pub fn grad_factor4(&self, r: f64x4) -> f64x4 {
+        let (dw_dr, at_zero) = self.derivative4(r);
+        at_zero.blend(f64x4::splat(self.grad_factor(0.0)), dw_dr / r)
+    }
+
     /// W'(r) in lanes, and the mask of the lanes with r = 0.
     #[inline(always)]
     pub fn derivative4(&self, r: f64x4) -> (f64x4, f64x4) {
@@ -82,6 +98,6 @@ impl<const D: usize> Quintic<D> {
     #[inline(always)]
     fn spline_terms4(&self, r: f64x4) -> [f64x4; 3] {
         let q = r * f64x4::splat(self.inv_h);
-        [3.0, 2.0, 1.0].map(|k| (f64x4::splat(k) - q).max(f64x4::ZERO))
+        [3.0, 2.0, 1.0].map(|k| (f64x4::splat(k) - q).fast_max(f64x4::ZERO))
     }
 }

@@ -60,7 +60,7 @@ pub fn stencil_slot<const D: usize>(offset: [i64; D]) -> usize {
 }
 
 /// The offset of cell `to` from cell `from` in a grid of `dims` cells, if they are neighbours.
-pub fn cell_offset<const D: usize>(dims: [usize; D], from: usize, to: usize) -> [i64; D] {
+fn cell_offset<const D: usize>(dims: [usize; D], from: usize, to: usize) -> [i64; D] {
     let (mut a, mut b) = (from, to);
     std::array::from_fn(|d| {
         let o = (b % dims[d]) as i64 - (a % dims[d]) as i64;

@@ -48,6 +48,12 @@ impl<const D: usize> Lanes<D> {
     pub fn active(&self, k: usize) -> bool {
         self.mask.to_array()[k] != 0.0
     }
+
+    /// The neighbours among the four lanes.
+    #[inline(always)]
+    pub fn count(&self) -> usize {
+        self.mask.move_mask().count_ones() as usize
+    }
 }
 
 /// a[j0 .. j0 + 4] with `fill` past the end of `a`.
@@ -171,7 +177,7 @@ impl<'a, const D: usize> Neighbours<'a, D> {
         let (dw_dr, at_zero) = self.kernel.derivative4(r);
         let r2 = r * r;
         let r2_eta2 = r2 + f64x4::splat(self.eta2);
-        let inv = f64x4::ONE / (r * r2_eta2).max(f64x4::splat(f64::MIN_POSITIVE));
+        let inv = f64x4::ONE / (r * r2_eta2).fast_max(f64x4::splat(f64::MIN_POSITIVE));
         let f = at_zero.blend(f64x4::splat(self.f_at_zero), dw_dr * r2_eta2 * inv);
         (f, dw_dr * r2 * inv)
     }

@@ -16,14 +16,14 @@
 
 use crate::free_surface::Support;
 use crate::linsolve::LinearOperator;
-use crate::multigrid::{cell_offset, stencil_slot, Aggregated};
-use crate::neighbours::Lanes;
+use crate::multigrid::{stencil_slot, Aggregated};
+use crate::neighbours::{Lanes, LANES};
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
-use crate::sph::{laplacian_coefficient, velocity_gradient, Correction, Corrections, Neighbours};
-use crate::wall::{behind_walls, ghost_velocity};
+use crate::sph::{velocity_gradient, Correction, Corrections, Neighbours};
+use crate::wall::{behind_walls, ghost_pressure_difference, ghost_velocity};
 use rayon::prelude::*;
-use wide::{f64x4, CmpNe};
+use wide::f64x4;
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,11 +76,12 @@ pub fn fluid_volumes<const D: usize>(p: &Particles<D>, nf: usize, out: &mut Vec<
 /// matrix of its pressure gradient is near-singular, whether or not the scene applies the
 /// kernel correction). Fluid that fills its container (`confined`) has no free surface: every
 /// fluid row is interior (a disordered patch of a periodic flow can look like a surface to the
-/// detection).
+/// detection). `fluid_neighbours` counts the fluid particles in its kernel support.
 pub fn role<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     support: &Support<D>,
+    fluid_neighbours: usize,
     gradient_defined: bool,
     confined: bool,
     i: usize,
@@ -88,8 +89,6 @@ pub fn role<const D: usize>(
     if confined {
         return Role::Interior;
     }
-    let mut fluid_neighbours = 0;
-    nb.for_each_of(i, &[Kind::Fluid], |_, _, _| fluid_neighbours += 1);
     if fluid_neighbours == 0 || !gradient_defined {
         Role::Splash
     } else if support.is_free_surface(nb, i, p.density[i] / p.rest_density[i]) {
@@ -127,7 +126,11 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
             return false;
         }
         let mut any_free = false;
-        nb.for_each_of(i, &[Kind::Fluid], |j, _, _| any_free |= roles[j].is_free());
+        nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+            for k in 0..LANES {
+                any_free |= l.active(k) & roles.get(l.j0 + k).is_some_and(|r| r.is_free());
+            }
+        });
         !any_free
     });
 }
@@ -227,16 +230,16 @@ fn divergence_source<const D: usize>(
     // Walls take the fluid's own u*_i less its normal velocity of the last step: the body force
     // is carried by the wall ghosts' Neumann condition, the wall's kinematic condition by the
     // divergence (see `wall::ghost_velocity`).
-    let u_star_of = |j: usize| -> [f64; D] { std::array::from_fn(|d| u_star[d][j]) };
-    let (u_star_i, u_i) = (u_star_of(i), p.velocity(i));
-    let velocity = |j: usize| -> [f64; D] {
-        match p.kind[j] {
-            Kind::Wall => ghost_velocity(p, j, u_star_i, u_i),
-            Kind::Fluid => u_star_of(j),
+    let u_star_i: [f64; D] = std::array::from_fn(|d| u_star[d][i]);
+    let u_i = p.velocity(i);
+    let velocity = |l: &Lanes<D>| -> [f64x4; D] {
+        match l.kind {
+            Kind::Wall => ghost_velocity(p, l, u_star_i, u_i),
+            Kind::Fluid => std::array::from_fn(|d| l.load(&u_star[d])),
         }
     };
     // ∇·u* = trace of the corrected velocity gradient, Eq. (22) with Eq. (24)–(25).
-    let grad_u = velocity_gradient(nb, p, l, velocity, i);
+    let grad_u = velocity_gradient(nb, p, l, u_star_i, velocity, i);
     let div: f64 = (0..D).map(|a| grad_u[a][a]).sum();
     let rho0 = p.rest_density[i];
     // Where the free surface truncates the kernel the summation density is low because
@@ -267,17 +270,21 @@ fn laplacian_correction<const D: usize>(
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    let mut c = [0.0; D];
-    nb.for_each(i, |j, rij, r| {
-        let cl = -laplacian_coefficient(nb, p, i, j, r);
-        let followed = match p.kind[j] {
-            Kind::Fluid => rij,
-            Kind::Wall => behind_walls(p, j, rij),
+    let mut c = [f64x4::ZERO; D];
+    let scale = f64x4::splat(2.0 / p.rest_density[i]);
+    nb.for_each_lanes(i, |lanes| {
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors4(lanes.r);
+        // −a_ij of Eq. (27) (`sph::laplacian_coefficient`).
+        let cl = (scale * lanes.load(&p.mass) * laplacian_factor) & lanes.mask;
+        let followed = match lanes.kind {
+            Kind::Fluid => lanes.rij,
+            Kind::Wall => behind_walls(p, lanes, lanes.rij),
         };
         for d in 0..D {
-            c[d] += cl * followed[d];
+            c[d] = cl.mul_add(followed[d], c[d]);
         }
     });
+    let c = c.map(|x| x.reduce_add());
     match l {
         Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[b][a] * c[b]).sum()),
         None => c,
@@ -322,24 +329,13 @@ impl<const D: usize> PressureOperator<'_, D> {
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
-        (laplacian - correction).max(f64x4::ZERO) & l.mask
+        (laplacian - correction).fast_max(f64x4::ZERO) & l.mask
     }
 
     /// The weights of interior row i with its fluid neighbours `l`.
     #[inline(always)]
     fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> f64x4 {
         self.interior_weights(row, l, l.load(&self.p.mass), l.load(self.fluid_volume))
-    }
-
-    /// P_b − P_i of the wall lanes (see `wall::ghost_pressure_difference`).
-    #[inline(always)]
-    fn ghosts(&self, i: usize, l: &Lanes<D>) -> f64x4 {
-        let p = self.p;
-        let g_r = (0..D).fold(f64x4::ZERO, |s, d| {
-            let across = l.load(&p.normal[d]).cmp_ne(f64x4::ZERO);
-            ((f64x4::splat(self.gravity[d]) * l.rij[d]) & across) + s
-        });
-        f64x4::splat(-p.rest_density[i]) * g_r
     }
 
     /// The wall part of the right-hand side of interior row i: the Neumann ghosts' known
@@ -350,7 +346,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
             let mass = l.load(&p.mass);
             let w = self.interior_weights(&row, l, mass, mass / l.load(&p.rest_density));
-            b += w * self.ghosts(i, l);
+            b += w * ghost_pressure_difference(p, self.gravity, i, l);
         });
         b.reduce_add()
     }
@@ -417,13 +413,14 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
     }
 
     fn add_coarse_row(&self, i: usize, row: &mut [f64]) {
-        let grid = self.nb.grid();
-        let (dims, cell) = (grid.blocks(), grid.block_of_sorted(i));
-        let centre = stencil_slot([0; D]);
         // Interior rows: a_ii = Σ w, a_ij = −w; the other rows are not aggregated.
         if self.roles[i] != Role::Interior {
             return;
         }
+        let (grid, p) = (self.nb.grid(), self.p);
+        let block =
+            |j: usize| -> [i64; D] { std::array::from_fn(|d| grid.block_along(d, p.pos[d][j])) };
+        let (centre, block_i) = (stencil_slot([0; D]), block(i));
         let constants = self.row_constants(i);
         self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
             let w = self.fluid_weights(&constants, l);
@@ -433,10 +430,11 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
                 }
                 row[centre] += w;
                 let j = l.j0 + k;
-                // A coupling across a periodic boundary joins cells at the two ends of the grid,
-                // outside the 3^D stencil: the coarse levels leave it out (their row keeps its
-                // diagonal), which only weakens the preconditioner near that boundary.
-                let offset = cell_offset(dims, cell, grid.block_of_sorted(j));
+                // A coupling across a periodic boundary joins blocks at the two ends of the
+                // grid, outside the 3^D stencil: the coarse levels leave it out (their row keeps
+                // its diagonal), which only weakens the preconditioner near that boundary.
+                let block_j = block(j);
+                let offset: [i64; D] = std::array::from_fn(|d| block_j[d] - block_i[d]);
                 if self.aggregate(j).is_some() && offset.iter().all(|o| o.abs() <= 1) {
                     row[stencil_slot(offset)] -= w;
                 }

@@ -20,7 +20,8 @@
 //! φ' = φ + (∇φ)·δr.
 
 use crate::particles::Particles;
-use crate::sph::Neighbours;
+use crate::sph::{volume_gradient_factor, Neighbours};
+use wide::f64x4;
 
 /// The constants of shifting (the scene's `[effects.shifting]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,16 +80,20 @@ impl Shifting {
         full_support: bool,
         i: usize,
     ) -> [f64; D] {
-        let mut grad_c = [0.0; D];
-        nb.for_each(i, |j, rij, r| {
-            let ratio = nb.kernel.w(r) / self.w_dx;
-            let c = p.mass[j] / p.rest_density[j]
-                * (1.0 + self.clustering_weight * ratio.powi(4))
-                * nb.kernel.grad_factor(r);
+        let mut grad = [f64x4::ZERO; D];
+        let (inv_w_dx, weight) = (
+            f64x4::splat(1.0 / self.w_dx),
+            f64x4::splat(self.clustering_weight),
+        );
+        nb.for_each_lanes(i, |l| {
+            let ratio = nb.kernel.w4(l.r) * inv_w_dx;
+            let ratio2 = ratio * ratio;
+            let c = volume_gradient_factor(nb, p, l) * weight.mul_add(ratio2 * ratio2, f64x4::ONE);
             for d in 0..D {
-                grad_c[d] += c * rij[d];
+                grad[d] = c.mul_add(l.rij[d], grad[d]);
             }
         });
+        let mut grad_c = grad.map(|g| g.reduce_add());
         if !full_support {
             let n = surface_normal;
             let normal_part: f64 = (0..D).map(|d| grad_c[d] * n[d]).sum();

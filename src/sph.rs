@@ -1,15 +1,30 @@
 //! SPH discretisation: the operators of Eq. (20)–(27) written as per-particle sums over the
 //! pair loop of `neighbours`.
 
+use crate::neighbours::Lanes;
 pub use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
-use crate::wall::{self, behind_walls, ghost_velocity, Face};
+use crate::wall::{behind_walls, ghost_velocity, Face};
+use wide::f64x4;
 
 /// Summation density ρ_i = Σ_j m_j W_ij (self included).
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
-    let mut rho = p.mass[i] * nb.kernel.w(0.0);
-    nb.for_each(i, |j, _, r| rho += p.mass[j] * nb.kernel.w(r));
-    rho
+    let mut rho = f64x4::ZERO;
+    nb.for_each_lanes(i, |l| {
+        rho = (l.load(&p.mass) * nb.kernel.w4(l.r) & l.mask) + rho;
+    });
+    p.mass[i] * nb.kernel.w(0.0) + rho.reduce_add()
+}
+
+/// V_j F(r_ij) of the lanes (zero in the masked ones), with V_j = m_j/ρ0_j: the weight of
+/// r_ij in the gradients of Eq. (20) and the moments of Eq. (25).
+#[inline(always)]
+pub fn volume_gradient_factor<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Lanes<D>,
+) -> f64x4 {
+    (l.load(&p.mass) / l.load(&p.rest_density) * nb.kernel.grad_factor4(l.r)) & l.mask
 }
 
 /// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, ν_t the eddy viscosity
@@ -29,31 +44,39 @@ pub fn viscous_acceleration<const D: usize>(
     face: Option<Face<D>>,
     i: usize,
 ) -> [f64; D] {
-    let nu_t = |j: usize| eddy.map_or(0.0, |e| e[j]);
-    let (rho_i, nu_i) = (p.rest_density[i], p.viscosity[i] + nu_t(i));
-    let d_i = face.map_or(f64::INFINITY, |f| f.distance);
+    let (rho_i, nu_laminar) = (p.rest_density[i], p.viscosity[i]);
+    let nu_i = nu_laminar + eddy.map_or(0.0, |e| e[i]);
+    let d_i = f64x4::splat(face.map_or(f64::INFINITY, |f| f.distance));
     let u_i = p.velocity(i);
-    let mut acc = [0.0; D];
-    nb.for_each(i, |j, r_ij, r| {
-        let (nu_i, nu_j, du) = match p.kind[j] {
+    let mut acc = [f64x4::ZERO; D];
+    nb.for_each_lanes(i, |l| {
+        let (nu_i, nu_j, du): (f64x4, f64x4, [f64x4; D]) = match l.kind {
             Kind::Wall => {
-                let beta = (wall::dot(p.wall_normal(j), r_ij) / d_i).clamp(1.0, MORRIS_BETA_MAX);
-                (p.viscosity[i], p.viscosity[i], u_i.map(|u| beta * u))
+                let n_r = (0..D).fold(f64x4::ZERO, |s, d| {
+                    l.load(&p.normal[d]).mul_add(l.rij[d], s)
+                });
+                let beta = (n_r / d_i)
+                    .fast_max(f64x4::ONE)
+                    .fast_min(f64x4::splat(MORRIS_BETA_MAX));
+                let nu = f64x4::splat(nu_laminar);
+                (nu, nu, u_i.map(|u| beta * f64x4::splat(u)))
             }
-            Kind::Fluid => (
-                nu_i,
-                p.viscosity[j] + nu_t(j),
-                std::array::from_fn(|d| u_i[d] - p.vel[d][j]),
-            ),
+            Kind::Fluid => {
+                let nu_t = eddy.map_or(f64x4::ZERO, |e| l.load(e));
+                let du = std::array::from_fn(|d| f64x4::splat(u_i[d]) - l.load(&p.vel[d]));
+                (f64x4::splat(nu_i), l.load(&p.viscosity) + nu_t, du)
+            }
         };
-        let rho_j = p.rest_density[j];
-        let c =
-            p.mass[j] * (rho_i * nu_i + rho_j * nu_j) / (rho_i * rho_j) * nb.laplacian_factor(r);
+        let (rho_j, rho_i) = (l.load(&p.rest_density), f64x4::splat(rho_i));
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors4(l.r);
+        let c = (l.load(&p.mass) * rho_i.mul_add(nu_i, rho_j * nu_j) / (rho_i * rho_j)
+            * laplacian_factor)
+            & l.mask;
         for d in 0..D {
-            acc[d] += c * du[d];
+            acc[d] = c.mul_add(du[d], acc[d]);
         }
     });
-    acc
+    acc.map(|a| a.reduce_add())
 }
 
 /// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right
@@ -62,26 +85,28 @@ pub fn viscous_acceleration<const D: usize>(
 const MORRIS_BETA_MAX: f64 = 4.0;
 
 /// Corrected gradient of a velocity field, G[b][a] = ∂u_a/∂x_b = Σ_c L_bc Σ_j V_j (u_j − u_i)_a ∂_c W_ij
-/// (Eq. 20 with Eq. 24–25), with `u(j)` the velocity taken for particle j.
+/// (Eq. 20 with Eq. 24–25), with `u_i` the velocity of particle i and `u(l)` the velocities
+/// taken for the neighbours in lanes `l`.
 pub fn velocity_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Correction<D>,
-    u: impl Fn(usize) -> [f64; D],
+    u_i: [f64; D],
+    u: impl Fn(&Lanes<D>) -> [f64x4; D],
     i: usize,
 ) -> [[f64; D]; D] {
-    let ui = u(i);
-    let mut g = [[0.0; D]; D];
-    nb.for_each(i, |j, rij, r| {
-        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
-        let uj = u(j);
+    let mut g = [[f64x4::ZERO; D]; D];
+    nb.for_each_lanes(i, |lanes| {
+        let vf = volume_gradient_factor(nb, p, lanes);
+        let u_j = u(lanes);
         for a in 0..D {
-            let du = uj[a] - ui[a];
+            let du = vf * (u_j[a] - f64x4::splat(u_i[a]));
             for b in 0..D {
-                g[b][a] += vf * du * rij[b];
+                g[b][a] = du.mul_add(lanes.rij[b], g[b][a]);
             }
         }
     });
+    let g = g.map(|row| row.map(|x| x.reduce_add()));
     std::array::from_fn(|b| {
         std::array::from_fn(|a| match l {
             Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
@@ -90,16 +115,14 @@ pub fn velocity_gradient<const D: usize>(
     })
 }
 
-/// The velocity of neighbour j in a velocity gradient at fluid particle i: its own for fluid,
-/// the free-slip ghost of u_i for walls (`wall::ghost_velocity`).
-#[inline]
-pub fn fluid_velocity<const D: usize>(p: &Particles<D>, i: usize, j: usize) -> [f64; D] {
-    match p.kind[j] {
-        Kind::Fluid => p.velocity(j),
-        Kind::Wall => {
-            let u_i = p.velocity(i);
-            ghost_velocity(p, j, u_i, u_i)
-        }
+/// The velocities of the neighbours in lanes `l` in a velocity gradient at fluid particle i of
+/// velocity `u_i`: their own for fluid, the free-slip ghost of u_i for walls
+/// (`wall::ghost_velocity`).
+#[inline(always)]
+pub fn fluid_velocity<const D: usize>(p: &Particles<D>, u_i: [f64; D], l: &Lanes<D>) -> [f64x4; D] {
+    match l.kind {
+        Kind::Fluid => std::array::from_fn(|d| l.load(&p.vel[d])),
+        Kind::Wall => ghost_velocity(p, l, u_i, u_i),
     }
 }
 
@@ -119,6 +142,8 @@ pub struct Moments<const D: usize> {
     pub m_neumann: [[f64; D]; D],
     /// ∇C_i = Σ_j V_j ∇W_ij, the concentration gradient.
     pub grad_c: [f64; D],
+    /// The fluid particles in the kernel support.
+    pub fluid_neighbours: usize,
 }
 
 /// The support moments of particle i.
@@ -127,28 +152,35 @@ pub fn support_moments<const D: usize>(
     p: &Particles<D>,
     i: usize,
 ) -> Moments<D> {
-    let mut mo = Moments {
-        m: [[0.0; D]; D],
-        m_neumann: [[0.0; D]; D],
-        grad_c: [0.0; D],
-    };
-    nb.for_each(i, |j, rij, r| {
-        let vf = p.mass[j] / p.rest_density[j] * nb.kernel.grad_factor(r);
+    let (mut m, mut m_neumann) = ([[f64x4::ZERO; D]; D], [[f64x4::ZERO; D]; D]);
+    let (mut grad_c, mut fluid_neighbours) = ([f64x4::ZERO; D], 0);
+    nb.for_each_lanes(i, |l| {
+        let vf = volume_gradient_factor(nb, p, l);
         // The part of r_ij the pressure of j follows: all of it for fluid, the normal part for
         // a wall ghost.
-        let followed = match p.kind[j] {
-            Kind::Fluid => rij,
-            Kind::Wall => behind_walls(p, j, rij),
+        let followed = match l.kind {
+            Kind::Fluid => {
+                fluid_neighbours += l.count();
+                l.rij
+            }
+            Kind::Wall => behind_walls(p, l, l.rij),
         };
         for a in 0..D {
-            mo.grad_c[a] += vf * rij[a];
+            let v = vf * l.rij[a];
+            grad_c[a] += v;
             for b in 0..D {
-                mo.m[a][b] -= vf * rij[a] * rij[b];
-                mo.m_neumann[a][b] -= vf * rij[a] * followed[b];
+                m[a][b] = (-v).mul_add(l.rij[b], m[a][b]);
+                m_neumann[a][b] = (-v).mul_add(followed[b], m_neumann[a][b]);
             }
         }
     });
-    mo
+    let sum = |x: [[f64x4; D]; D]| x.map(|row| row.map(|v| v.reduce_add()));
+    Moments {
+        m: sum(m),
+        m_neumann: sum(m_neumann),
+        grad_c: grad_c.map(|v| v.reduce_add()),
+        fluid_neighbours,
+    }
 }
 
 /// Kernel gradient correction L_i = M_i⁻¹, Eq. (24)–(25), so that L_i Σ_j V_j (φ_j − φ_i) ∇W_ij
@@ -250,24 +282,24 @@ pub fn apply_correction<const D: usize>(l: &Correction<D>, v: [f64; D]) -> [f64;
 }
 
 /// Corrected gradient of a scalar field, ∇φ_i = L_i Σ_j V_j (φ_j − φ_i) ∇W_ij, Eq. (20) with
-/// Eq. (24)–(25), with `difference(j, r_ij)` = φ_j − φ_i: exact for linear φ also where the
-/// kernel support is truncated.
+/// Eq. (24)–(25), with `difference(l)` = φ_j − φ_i of the neighbours in lanes `l`: exact for
+/// linear φ also where the kernel support is truncated.
 #[inline]
 pub fn gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Correction<D>,
     i: usize,
-    difference: impl Fn(usize, [f64; D]) -> f64,
+    difference: impl Fn(&Lanes<D>) -> f64x4,
 ) -> [f64; D] {
-    let mut grad = [0.0; D];
-    nb.for_each(i, |j, rij, r| {
-        let c = p.mass[j] / p.rest_density[j] * difference(j, rij) * nb.kernel.grad_factor(r);
+    let mut grad = [f64x4::ZERO; D];
+    nb.for_each_lanes(i, |lanes| {
+        let c = volume_gradient_factor(nb, p, lanes) * difference(lanes);
         for d in 0..D {
-            grad[d] += c * rij[d];
+            grad[d] = c.mul_add(lanes.rij[d], grad[d]);
         }
     });
-    apply_correction(l, grad)
+    apply_correction(l, grad.map(|g| g.reduce_add()))
 }
 
 /// Coefficient a_ij ≥ 0 of the negative Laplacian of Eq. (27):

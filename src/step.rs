@@ -15,6 +15,7 @@ use crate::kernel::Quintic;
 use crate::linsolve::{BiCgStab, SolveInfo, SolverError, SolverParams};
 use crate::memory::{ArraySize, Holds};
 use crate::multigrid::Multigrid;
+use crate::neighbours::Lanes;
 use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::{self, fill, fill_vector};
@@ -27,6 +28,7 @@ use crate::wall;
 use rayon::iter::Either;
 use rayon::prelude::*;
 use std::time::Instant;
+use wide::f64x4;
 
 /// The constants of a step that come from the scene.
 #[derive(Clone, Copy, Debug)]
@@ -334,7 +336,15 @@ impl<const D: usize> Workspace<D> {
                 let mo = sph::support_moments(nb, p, i);
                 let l_pressure = sph::gradient_correction(mo.m_neumann);
                 let support = Support::new(&mo.m, mo.grad_c);
-                *role = ppe::role(nb, p, &support, l_pressure.is_some(), set.confined, i);
+                *role = ppe::role(
+                    nb,
+                    p,
+                    &support,
+                    mo.fluid_neighbours,
+                    l_pressure.is_some(),
+                    set.confined,
+                    i,
+                );
                 if let Some(normal) = normal {
                     *normal = support.normal;
                 }
@@ -490,7 +500,7 @@ impl<const D: usize> Workspace<D> {
             a.resize(n, 0.0);
         }
         self.contact.resize(n, wall::NO_CONTACT);
-        fill(&mut self.contact, |i| wall::contact(nb, p, set.spacing, i));
+        fill(&mut self.contact, |i| wall::contact(nb, set.spacing, i));
         let (u_star, contact) = (&self.u_star, &self.contact);
         let corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
@@ -515,8 +525,11 @@ impl<const D: usize> Workspace<D> {
             if !full[i] {
                 return [0.0; 4];
             }
-            let mut nearest = f64::INFINITY;
-            nb.for_each(i, |_, _, r| nearest = nearest.min(r));
+            let mut nearest = f64x4::splat(f64::INFINITY);
+            nb.for_each_lanes(i, |l| {
+                nearest = nearest.fast_min(l.mask.blend(l.r, f64x4::splat(f64::INFINITY)));
+            });
+            let nearest = nearest.to_array().into_iter().fold(f64::INFINITY, f64::min);
             let error = (p.density[i] / p.rest_density[i] - 1.0).abs();
             [1.0, error, nearest, nearest * nearest]
         });
@@ -573,13 +586,9 @@ impl<const D: usize> Workspace<D> {
             if !full[i] {
                 return p.velocity(i);
             }
-            let g = sph::velocity_gradient(
-                nb,
-                p,
-                corrections.of(i),
-                |j| sph::fluid_velocity(p, i, j),
-                i,
-            );
+            let u_i = p.velocity(i);
+            let u = |l: &Lanes<D>| sph::fluid_velocity(p, u_i, l);
+            let g = sph::velocity_gradient(nb, p, corrections.of(i), u_i, u, i);
             let dr = vector(shift, i);
             std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
         });
@@ -643,9 +652,10 @@ fn pressure_gradient<const D: usize>(
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    sph::gradient(nb, p, l, i, |j, rij| match p.kind[j] {
-        Kind::Fluid => p.pressure[j] - p.pressure[i],
-        Kind::Wall => wall::ghost_pressure_difference(p, gravity, i, j, rij),
+    let p_i = f64x4::splat(p.pressure[i]);
+    sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
+        Kind::Fluid => lanes.load(&p.pressure) - p_i,
+        Kind::Wall => wall::ghost_pressure_difference(p, gravity, i, lanes),
     })
 }
 

@@ -56,7 +56,8 @@ pub fn eddy_viscosity<const D: usize>(
     i: usize,
 ) -> f64 {
     let cs_delta = cs * spacing;
-    let grad = velocity_gradient(nb, p, l, |j| fluid_velocity(p, i, j), i);
+    let u_i = p.velocity(i);
+    let grad = velocity_gradient(nb, p, l, u_i, |l| fluid_velocity(p, u_i, l), i);
     let mut ss = 0.0;
     for a in 0..D {
         for b in 0..D {

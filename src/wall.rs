@@ -20,30 +20,37 @@
 //! the wall particles take the wall velocity (zero) plus the fluid particle's own predictor
 //! increment (see `ppe::source`).
 
+use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::scene::Aabb;
 use crate::sph::Neighbours;
+use wide::{f64x4, CmpNe};
 
-/// P_b − P_i of the ghost pressure of wall particle b seen from fluid particle i, with
-/// r_ib = r_i − r_b.
-#[inline]
+/// P_b − P_i = −ρ0_i g·N_b r_ib of the ghost pressures of the wall particles b in lanes `l`
+/// seen from fluid particle i (r_ib = r_i − r_b, the lanes' r_ij).
+#[inline(always)]
 pub fn ghost_pressure_difference<const D: usize>(
     p: &Particles<D>,
     gravity: [f64; D],
     i: usize,
-    b: usize,
-    r_ib: [f64; D],
-) -> f64 {
-    -p.rest_density[i] * dot(gravity, behind_walls(p, b, r_ib))
+    l: &Lanes<D>,
+) -> f64x4 {
+    let across = behind_walls(p, l, l.rij);
+    let g_r = (0..D).fold(f64x4::ZERO, |s, d| {
+        f64x4::splat(gravity[d]).mul_add(across[d], s)
+    });
+    f64x4::splat(-p.rest_density[i]) * g_r
 }
 
-/// N_b r: the part of r across the walls wall particle b lies behind (see the module doc).
-#[inline]
-pub fn behind_walls<const D: usize>(p: &Particles<D>, b: usize, r: [f64; D]) -> [f64; D] {
-    std::array::from_fn(|d| if p.normal[d][b] != 0.0 { r[d] } else { 0.0 })
+/// N_b r: the part of r across the walls the wall particles b in lanes `l` lie behind (see
+/// the module doc).
+#[inline(always)]
+pub fn behind_walls<const D: usize>(p: &Particles<D>, l: &Lanes<D>, r: [f64x4; D]) -> [f64x4; D] {
+    std::array::from_fn(|d| r[d] & l.load(&p.normal[d]).cmp_ne(f64x4::ZERO))
 }
 
-/// The velocity wall particle b takes in the velocity gradients of fluid particle i (the
+/// The velocities the wall particles b in lanes `l` take in the velocity gradients of fluid
+/// particle i (the
 /// divergence of the PPE source, the strain rate of the eddy viscosity, the Taylor correction
 /// of shifting): the fluid's own velocity `u_i` with its normal part `u_n` (relative to the wall,
 /// at rest) removed, N_b here as for the pressure ghosts. The wall is then felt only through
@@ -51,15 +58,15 @@ pub fn behind_walls<const D: usize>(p: &Particles<D>, b: usize, r: [f64; D]) -> 
 /// free-slip ghost. At rest in these gradients (no-slip), the wall shows a shear of order
 /// U/dx, which the kernel correction mixes into the divergence where the support is truncated
 /// (a surge front) and which a shift across it turns into a spurious change of velocity.
-#[inline]
+#[inline(always)]
 pub fn ghost_velocity<const D: usize>(
     p: &Particles<D>,
-    b: usize,
+    l: &Lanes<D>,
     u_i: [f64; D],
     u_n: [f64; D],
-) -> [f64; D] {
-    let across = behind_walls(p, b, u_n);
-    std::array::from_fn(|d| u_i[d] - across[d])
+) -> [f64x4; D] {
+    let across = behind_walls(p, l, u_n.map(f64x4::splat));
+    std::array::from_fn(|d| f64x4::splat(u_i[d]) - across[d])
 }
 
 /// What the ghost pressures of the walls are made of, borrowed apart from the pressures
@@ -75,17 +82,25 @@ impl<const D: usize> Ghosts<'_, D> {
     /// ghost pressures its fluid neighbours give it (zero where no fluid is in reach), with
     /// `fluid_pressure` the pressures of the fluid particles.
     pub fn wall_pressure(&self, nb: &Neighbours<D>, fluid_pressure: &[f64], b: usize) -> f64 {
-        let (mut sum, mut weights) = (0.0, 0.0);
-        nb.for_each_of(b, &[Kind::Fluid], |f, r_bf, r| {
-            let w = nb.kernel.w(r);
-            // P_b − P_f = −ρ0 g·N_b r_fb (see the module doc), r_fb = −r_bf.
-            let across: f64 = (0..D)
-                .filter(|&d| self.normal[d][b] != 0.0)
-                .map(|d| self.gravity[d] * r_bf[d])
-                .sum();
-            sum += w * (fluid_pressure[f] + self.rest_density[f] * across);
+        // P_b − P_f = −ρ0_f g·N_b r_fb (see the module doc), r_fb = −r_bf; N_b is b's own.
+        let g_across: [f64x4; D] = std::array::from_fn(|d| {
+            f64x4::splat(if self.normal[d][b] != 0.0 {
+                self.gravity[d]
+            } else {
+                0.0
+            })
+        });
+        let (mut sum, mut weights) = (f64x4::ZERO, f64x4::ZERO);
+        nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
+            let w = nb.kernel.w4(l.r) & l.mask;
+            let g_r = (0..D).fold(f64x4::ZERO, |s, d| g_across[d].mul_add(l.rij[d], s));
+            let ghost = l
+                .load(self.rest_density)
+                .mul_add(g_r, l.load(fluid_pressure));
+            sum = w.mul_add(ghost, sum);
             weights += w;
         });
+        let (sum, weights) = (sum.reduce_add(), weights.reduce_add());
         if weights > 0.0 {
             sum / weights
         } else {
@@ -97,13 +112,12 @@ impl<const D: usize> Ghosts<'_, D> {
 /// The wall particle b nearest to particle i closer than `within`, with r_ib and |r_ib|, if any.
 pub fn nearest_wall<const D: usize>(
     nb: &Neighbours<D>,
-    p: &Particles<D>,
     within: f64,
     i: usize,
 ) -> Option<(usize, [f64; D], f64)> {
     let mut nearest = (within, None);
-    nb.for_each(i, |j, rij, r| {
-        if !p.is_fluid(j) && r < nearest.0 {
+    nb.for_each_of(i, &[Kind::Wall], |j, rij, r| {
+        if r < nearest.0 {
             nearest = (r, Some((j, rij)));
         }
     });
@@ -132,7 +146,7 @@ pub fn nearest_face<const D: usize>(
     within: f64,
     i: usize,
 ) -> Option<Face<D>> {
-    let (b, r_ib, reach) = nearest_wall(nb, p, within, i)?;
+    let (b, r_ib, reach) = nearest_wall(nb, within, i)?;
     let normal = p.wall_normal(b);
     Some(Face {
         distance: (dot(r_ib, normal) - 0.5 * spacing).max(0.25 * spacing),
@@ -146,13 +160,8 @@ pub const NO_CONTACT: u32 = u32::MAX;
 
 /// The wall particle a fluid particle touches: the nearest one closer than the spacing dx
 /// (nearer than at rest), or `NO_CONTACT`.
-pub fn contact<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    spacing: f64,
-    i: usize,
-) -> u32 {
-    nearest_wall(nb, p, spacing, i).map_or(NO_CONTACT, |(b, _, _)| b as u32)
+pub fn contact<const D: usize>(nb: &Neighbours<D>, spacing: f64, i: usize) -> u32 {
+    nearest_wall(nb, spacing, i).map_or(NO_CONTACT, |(b, _, _)| b as u32)
 }
 
 /// The normal of the wall a particle touches (`contact`), zero where it touches none.

@@ -16,6 +16,7 @@ mod neighbours;
 mod operators;
 mod output_readers;
 mod periodic_flows;
+mod simd;
 mod stability;
 mod study;
 mod validation;
