@@ -1,10 +1,10 @@
 //! Initial particles on a lattice of spacing dx anchored at the container's lower corner:
 //! fluid blocks, the container's dummy wall layers and solid obstacles.
 
+use crate::faces::Faces;
 use crate::kernel::SUPPORT_IN_H;
 use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
 use crate::scene::Scene;
-use crate::wall::wall_normal;
 
 /// Number of dummy wall layers that fill the kernel support 3h.
 pub fn wall_layers(scene: &Scene) -> usize {
@@ -38,11 +38,12 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
             });
         }
     });
+    let faces = Faces::new(scene);
     let wall_density = scene.fluids[0].density;
     let wall = |x: [f64; D]| NewParticle {
         pos: x,
         kind: Kind::Wall,
-        normal: wall_normal(&scene.container, &scene.obstacles, x),
+        normal: faces.wall_normal(x),
         fluid: NO_FLUID,
         mass: wall_density * volume,
         rest_density: wall_density,

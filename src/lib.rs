@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod child;
+pub mod faces;
 pub mod free_surface;
 pub mod grid;
 pub mod io;

@@ -1,6 +1,7 @@
 //! The state of a run and its time stepping: the cell sort, the time-step limits, the
 //! projection step of `step`, and the diagnostics of each step.
 
+use crate::faces::{Contact, Faces};
 use crate::grid::CellList;
 use crate::kernel::{Quintic, SUPPORT_IN_H};
 use crate::lattice;
@@ -8,10 +9,9 @@ use crate::linsolve::{SolverError, SolverParams};
 use crate::memory::ArraySize;
 use crate::particles::Particles;
 use crate::reduce;
-use crate::scene::{Aabb, Scene};
+use crate::scene::Scene;
 use crate::step::{speed, StepReport, StepSettings, Workspace};
 use crate::timings::{Stage, Timings};
-use crate::wall::{self, Contact};
 use std::time::Instant;
 
 /// Viscous time-step limit Δt ≤ C_ν h²/ν.
@@ -76,9 +76,7 @@ pub struct Simulation<const D: usize> {
     kernel: Quintic<D>,
     grid: CellList<D>,
     settings: StepSettings<D>,
-    container: Aabb,
-    periodic: [bool; D],
-    obstacles: Vec<Aabb>,
+    faces: Faces,
     cfl: f64,
     max_viscosity: f64,
     /// Arrays of the cell sort: cell of each particle, the sorting permutation, scratch.
@@ -128,9 +126,7 @@ impl<const D: usize> Simulation<D> {
                 effects: scene.effects,
                 confined,
             },
-            container: scene.container.clone(),
-            periodic,
-            obstacles: scene.obstacles.clone(),
+            faces: Faces::new(scene),
             cfl: scene.solver.cfl,
             max_viscosity: scene.fluids.iter().map(|f| f.viscosity).fold(0.0, f64::max),
             cell_of: Vec::new(),
@@ -219,6 +215,7 @@ impl<const D: usize> Simulation<D> {
                 &self.grid,
                 self.kernel,
                 &self.settings,
+                &self.faces,
                 dt,
                 &mut self.timings,
             )
@@ -287,7 +284,7 @@ impl<const D: usize> Simulation<D> {
         arrays
     }
 
-    /// `wall::face_contact` for every fluid particle, a quarter spacing off the faces (at rest
+    /// `Faces::contact` for every fluid particle, a quarter spacing off the faces (at rest
     /// the fluid sits half a spacing off them). Returns the penetrations the step's advection
     /// made, counted before the contact puts them back: the particles the walls' pressure did
     /// not stop. Timed as part of the advection.
@@ -301,14 +298,7 @@ impl<const D: usize> Simulation<D> {
                 continue;
             }
             let (mut x, mut u) = (p.position(i), p.velocity(i));
-            match wall::face_contact(
-                &self.container,
-                self.periodic,
-                &self.obstacles,
-                gap,
-                &mut x,
-                &mut u,
-            ) {
+            match self.faces.contact(gap, &mut x, &mut u) {
                 Contact::Clear => continue,
                 Contact::Near => {}
                 Contact::Crossed => penetrations += 1,

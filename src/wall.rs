@@ -22,7 +22,6 @@
 
 use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
-use crate::scene::Aabb;
 use crate::sph::Neighbours;
 use wide::{f64x4, CmpNe};
 
@@ -155,124 +154,6 @@ pub fn nearest_face<const D: usize>(
     })
 }
 
-/// `contact` of a particle touching no wall.
-pub const NO_CONTACT: u32 = u32::MAX;
-
-/// The wall particle a fluid particle touches: the nearest one closer than the spacing dx
-/// (nearer than at rest), or `NO_CONTACT`.
-pub fn contact<const D: usize>(nb: &Neighbours<D>, spacing: f64, i: usize) -> u32 {
-    nearest_wall(nb, spacing, i).map_or(NO_CONTACT, |(b, _, _)| b as u32)
-}
-
-/// The normal of the wall a particle touches (`contact`), zero where it touches none.
-pub fn contact_normal<const D: usize>(p: &Particles<D>, contact: u32) -> [f64; D] {
-    if contact == NO_CONTACT {
-        [0.0; D]
-    } else {
-        p.wall_normal(contact as usize)
-    }
-}
-
-/// The kinematic wall condition v·n ≥ 0 for a velocity or displacement v of a fluid particle
-/// touching a wall of normal n (see `contact_normal`): v ← v − min(v·n, 0) n. The pressure
-/// keeps fluid with neighbours off the walls; this catches what it cannot hold, a drop of spray
-/// with no fluid around it, which meets the wall inelastically.
-pub fn no_penetration<const D: usize>(v: [f64; D], n: [f64; D]) -> [f64; D] {
-    let v_n = dot(v, n).min(0.0);
-    std::array::from_fn(|d| v[d] - v_n * n[d])
-}
-
 pub fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
     (0..D).map(|d| a[d] * b[d]).sum()
-}
-
-/// Unit normal of the wall at wall particle position x, pointing into the fluid: towards the
-/// container for container walls, out of the nearest face for obstacle particles.
-pub fn wall_normal<const D: usize>(container: &Aabb, obstacles: &[Aabb], x: [f64; D]) -> [f64; D] {
-    let to_box: [f64; D] =
-        std::array::from_fn(|d| x[d].clamp(container.min[d], container.max[d]) - x[d]);
-    let len = to_box.iter().map(|v| v * v).sum::<f64>().sqrt();
-    if len > 0.0 {
-        return to_box.map(|v| v / len);
-    }
-    let mut best = (f64::INFINITY, [0.0; D]);
-    for o in obstacles {
-        for d in 0..D {
-            for (gap, sign) in [(x[d] - o.min[d], -1.0), (o.max[d] - x[d], 1.0)] {
-                if gap.abs() < best.0 {
-                    let mut n = [0.0; D];
-                    n[d] = sign;
-                    best = (gap.abs(), n);
-                }
-            }
-        }
-    }
-    best.1
-}
-
-/// What `face_contact` did to a particle.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Contact {
-    /// Nothing: the particle is more than `gap` inside the container and outside every obstacle.
-    Clear,
-    /// Put back `gap` off a face it had come closer to than `gap`, without crossing it.
-    Near,
-    /// Put back from beyond a face: its centre was outside the container or inside an
-    /// obstacle (a penetration).
-    Crossed,
-}
-
-/// Hard contact with the walls' faces, the last line of the wall condition: a fluid particle
-/// whose step ended within `gap` of a face of the container or inside an obstacle (a fast
-/// particle at a large CFL number can cross the half spacing between the fluid and a face in
-/// one step, where the ghost pressure has had no time to stop it) is put back `gap` inside the
-/// fluid's side of that face, and its velocity loses the part into the face (an inelastic
-/// contact, as `no_penetration`).
-pub fn face_contact<const D: usize>(
-    container: &Aabb,
-    periodic: [bool; D],
-    obstacles: &[Aabb],
-    gap: f64,
-    x: &mut [f64; D],
-    u: &mut [f64; D],
-) -> Contact {
-    let mut contact = Contact::Clear;
-    // A periodic axis has no faces.
-    for d in (0..D).filter(|&d| !periodic[d]) {
-        let (lo, hi) = (container.min[d] + gap, container.max[d] - gap);
-        if x[d] < container.min[d] || x[d] > container.max[d] {
-            contact = Contact::Crossed;
-        } else if contact == Contact::Clear && (x[d] < lo || x[d] > hi) {
-            contact = Contact::Near;
-        }
-        if x[d] < lo {
-            (x[d], u[d]) = (lo, u[d].max(0.0));
-        } else if x[d] > hi {
-            (x[d], u[d]) = (hi, u[d].min(0.0));
-        }
-    }
-    for o in obstacles {
-        if !o.contains(x.as_slice()) {
-            continue;
-        }
-        // Out through the nearest face: along axis d, towards −1 (min face) or +1 (max face).
-        let (mut depth, mut d, mut sign) = (f64::INFINITY, 0, 0.0);
-        for axis in 0..D {
-            for (inside, s) in [(x[axis] - o.min[axis], -1.0), (o.max[axis] - x[axis], 1.0)] {
-                if inside < depth {
-                    (depth, d, sign) = (inside, axis, s);
-                }
-            }
-        }
-        x[d] = if sign < 0.0 {
-            o.min[d] - gap
-        } else {
-            o.max[d] + gap
-        };
-        if u[d] * sign < 0.0 {
-            u[d] = 0.0;
-        }
-        contact = Contact::Crossed;
-    }
-    contact
 }

@@ -1,9 +1,10 @@
-//! `wall::face_contact`, the hard contact at the end of a step: a particle that crossed a face, or
-//! came closer to it than `gap`, is put back `gap` inside and keeps no velocity into the face; one
-//! that did not is left alone. Only the crossings count as penetrations.
+//! The walls' faces (`faces`): the hard contact at the end of a step (a particle that crossed a
+//! face, or came closer to it than `gap`, is put back `gap` inside and keeps no velocity into the
+//! face; one that did not is left alone; only the crossings count as penetrations), the
+//! kinematic condition of the particles touching a face, and the wall particles' normals.
 
+use isph::faces::{Contact, Faces};
 use isph::scene::Aabb;
-use isph::wall::{face_contact, Contact};
 
 fn aabb(min: [f64; 2], max: [f64; 2]) -> Aabb {
     Aabb {
@@ -12,22 +13,24 @@ fn aabb(min: [f64; 2], max: [f64; 2]) -> Aabb {
     }
 }
 
+/// The unit box with these obstacles.
+fn faces(obstacles: &[Aabb]) -> Faces {
+    Faces {
+        container: aabb([0.0, 0.0], [1.0, 1.0]),
+        periodic: vec![false; 2],
+        obstacles: obstacles.to_vec(),
+    }
+}
+
 #[test]
 fn a_particle_beyond_the_container_is_put_back_inside() {
-    let container = aabb([0.0, 0.0], [1.0, 1.0]);
     let (mut x, mut u) = ([-0.01, 1.02], [-2.0, 0.5]);
-    assert_eq!(
-        face_contact(&container, [false; 2], &[], 0.1, &mut x, &mut u),
-        Contact::Crossed
-    );
+    assert_eq!(faces(&[]).contact(0.1, &mut x, &mut u), Contact::Crossed);
     assert_eq!(x, [0.1, 0.9]);
     // Beyond the left and the top face: both velocity components point into their faces.
     assert_eq!(u, [0.0, 0.0]);
     let (mut x, mut u) = ([1.5, 0.5], [-1.0, 0.3]);
-    assert_eq!(
-        face_contact(&container, [false; 2], &[], 0.1, &mut x, &mut u),
-        Contact::Crossed
-    );
+    assert_eq!(faces(&[]).contact(0.1, &mut x, &mut u), Contact::Crossed);
     assert_eq!(
         (x, u),
         ([0.9, 0.5], [-1.0, 0.3]),
@@ -37,18 +40,10 @@ fn a_particle_beyond_the_container_is_put_back_inside() {
 
 #[test]
 fn a_particle_inside_an_obstacle_leaves_through_the_nearest_face() {
-    let container = aabb([0.0, 0.0], [1.0, 1.0]);
     let obstacle = aabb([0.4, 0.0], [0.6, 0.3]);
     let (mut x, mut u) = ([0.45, 0.28], [0.2, -1.0]);
     assert_eq!(
-        face_contact(
-            &container,
-            [false; 2],
-            &[obstacle.clone()],
-            0.01,
-            &mut x,
-            &mut u
-        ),
+        faces(&[obstacle.clone()]).contact(0.01, &mut x, &mut u),
         Contact::Crossed
     );
     assert!(
@@ -58,7 +53,7 @@ fn a_particle_inside_an_obstacle_leaves_through_the_nearest_face() {
     assert_eq!(u, [0.2, 0.0]);
     let (mut x, mut u) = ([0.405, 0.1], [1.0, 0.0]);
     assert_eq!(
-        face_contact(&container, [false; 2], &[obstacle], 0.01, &mut x, &mut u),
+        faces(&[obstacle]).contact(0.01, &mut x, &mut u),
         Contact::Crossed
     );
     assert!((x[0] - 0.39).abs() < 1e-12, "{x:?}");
@@ -67,11 +62,10 @@ fn a_particle_inside_an_obstacle_leaves_through_the_nearest_face() {
 
 #[test]
 fn a_particle_clear_of_every_face_is_left_alone() {
-    let container = aabb([0.0, 0.0], [1.0, 1.0]);
     let obstacle = aabb([0.4, 0.0], [0.6, 0.3]);
     let (mut x, mut u) = ([0.2, 0.5], [3.0, -4.0]);
     assert_eq!(
-        face_contact(&container, [false; 2], &[obstacle], 0.05, &mut x, &mut u),
+        faces(&[obstacle]).contact(0.05, &mut x, &mut u),
         Contact::Clear
     );
     assert_eq!((x, u), ([0.2, 0.5], [3.0, -4.0]));
@@ -79,11 +73,59 @@ fn a_particle_clear_of_every_face_is_left_alone() {
 
 #[test]
 fn a_particle_closer_than_the_gap_is_put_back_but_did_not_cross() {
-    let container = aabb([0.0, 0.0], [1.0, 1.0]);
     let (mut x, mut u) = ([0.5, 0.02], [0.1, -0.3]);
-    assert_eq!(
-        face_contact(&container, [false; 2], &[], 0.05, &mut x, &mut u),
-        Contact::Near
-    );
+    assert_eq!(faces(&[]).contact(0.05, &mut x, &mut u), Contact::Near);
     assert_eq!((x, u), ([0.5, 0.05], [0.1, 0.0]));
+}
+
+#[test]
+fn an_obstacle_on_the_floor_has_no_face_there() {
+    // The obstacle stands on the container's floor: a particle inside it near its bottom
+    // leaves through its side, not through the floor, and the wall particles of its bottom
+    // row take the normal of the face the fluid meets.
+    let obstacle = aabb([0.4, 0.0], [0.6, 0.3]);
+    let f = faces(&[obstacle]);
+    let (mut x, mut u) = ([0.43, 0.02], [1.0, -1.0]);
+    assert_eq!(f.contact(0.01, &mut x, &mut u), Contact::Crossed);
+    assert!((x[0] - 0.39).abs() < 1e-12 && x[1] == 0.02, "{x:?}");
+    assert_eq!(u, [0.0, -1.0]);
+    assert_eq!(f.wall_normal([0.425, 0.025]), [-1.0, 0.0]);
+}
+
+#[test]
+fn an_obstacle_edge_particle_has_the_diagonal_normal() {
+    let f = faces(&[aabb([0.4, 0.0], [0.6, 0.3])]);
+    let n = f.wall_normal([0.425, 0.275]);
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    assert!(
+        (n[0] + h).abs() < 1e-12 && (n[1] - h).abs() < 1e-12,
+        "{n:?}"
+    );
+    assert_eq!(f.wall_normal([0.5, 0.29]), [0.0, 1.0]);
+}
+
+#[test]
+fn a_particle_touching_a_face_keeps_no_velocity_into_it() {
+    let f = faces(&[aabb([0.4, 0.0], [0.6, 0.3])]);
+    // On the floor: the downward part goes, the rest stays.
+    assert_eq!(
+        f.no_penetration([0.2, 0.004], [1.0, -2.0], 0.005),
+        [1.0, 0.0]
+    );
+    assert_eq!(
+        f.no_penetration([0.2, 0.004], [1.0, 2.0], 0.005),
+        [1.0, 2.0]
+    );
+    // In front of the obstacle's left face, and off its top-left edge (towards the edge).
+    assert_eq!(
+        f.no_penetration([0.397, 0.1], [3.0, 1.0], 0.005),
+        [0.0, 1.0]
+    );
+    let v = f.no_penetration([0.398, 0.302], [1.0, -1.0], 0.005);
+    assert!(v[0].abs() < 1e-12 && v[1].abs() < 1e-12, "{v:?}");
+    // Out of reach: untouched.
+    assert_eq!(
+        f.no_penetration([0.3, 0.5], [3.0, -4.0], 0.005),
+        [3.0, -4.0]
+    );
 }
