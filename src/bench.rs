@@ -308,6 +308,7 @@ impl<const D: usize> PpeSetup<D> {
             row_vectors: &self.row_vectors,
             fluid_volume: &self.fluid_volume,
             gravity,
+            ghost_gravity: gravity,
         }
     }
 

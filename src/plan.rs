@@ -4,7 +4,7 @@
 //! the plan and the step cannot disagree.
 
 use crate::lattice;
-use crate::scene::{Effects, Scene};
+use crate::scene::{Effects, GhostPressure, Scene};
 use crate::simulation::{NoFluid, Simulation};
 use crate::sph::Correction;
 use crate::step;
@@ -114,9 +114,13 @@ fn describe(stage: Stage, scene: &Scene) -> String {
             None => "Eq. (5): u* = u + Δt (∇·(ν∇u) (Eq. 26) + g), no-slip wall pairs".into(),
         },
         Stage::PressureSolve => format!(
-            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: Neumann ghosts of the fluid pressure (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start",
+            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start",
             if effects.kernel_correction { " (corrected by L_i)" } else { "" },
-            scene.solver.alpha
+            scene.solver.alpha,
+            match scene.walls.ghost_pressure {
+                GhostPressure::Hydrostatic => "Neumann ghosts of the fluid pressure, P_b = P_i + ρ0 g·N_b r_bi",
+                GhostPressure::Mirror => "mirror ghosts of the fluid pressure, P_b = P_i (∂P/∂n = 0)",
+            }
         ),
         Stage::Corrector => format!(
             "Eq. (7): u = u* − (Δt/ρ0)∇P, ∇P {} with the walls as ghosts; no velocity into a wall within dx",

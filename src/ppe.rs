@@ -301,6 +301,8 @@ pub struct PressureOperator<'a, const D: usize> {
     /// V_j = m_j/ρ0_j of the fluid particles, the unknowns the rows couple (`fluid_volumes`).
     pub fluid_volume: &'a [f64],
     pub gravity: [f64; D],
+    /// The gravity the wall ghosts' pressures carry (`StepSettings::ghost_gravity`).
+    pub ghost_gravity: [f64; D],
 }
 
 /// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
@@ -346,7 +348,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
             let mass = l.load(&p.mass);
             let w = self.interior_weights(&row, l, mass, mass / l.load(&p.rest_density));
-            b += w * ghost_pressure_difference(p, self.gravity, i, l);
+            b += w * ghost_pressure_difference(p, self.ghost_gravity, i, l);
         });
         b.reduce_add()
     }

@@ -5,8 +5,14 @@
 
 use rayon::prelude::*;
 
-/// Chunk length of the fixed-order reductions and of the per-particle blocks.
-pub const CHUNK: usize = 2048;
+/// Chunk length of the fixed-order sums: their partial sums, added in chunk order, give the
+/// same bits for any thread count.
+const CHUNK: usize = 2048;
+
+/// Length of the blocks the per-particle loops (`fill`, `fill_vector`) hand to a thread. Their
+/// results do not depend on how the work is split, so the blocks can be short: a 2D scene of a
+/// couple of thousand fluid particles (fewer than one `CHUNK`) still keeps every thread busy.
+const BLOCK: usize = 128;
 
 /// Σ_i f(i) for i in 0..n, summed in fixed chunks (deterministic for any thread count).
 pub fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
@@ -45,11 +51,11 @@ pub fn count(n: usize, pred: impl Fn(usize) -> bool + Sync) -> usize {
 
 /// out[i] = f(i) for every i, in parallel.
 pub fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync) {
-    out.par_chunks_mut(CHUNK)
+    out.par_chunks_mut(BLOCK)
         .enumerate()
         .for_each(|(c, block)| {
             for (k, o) in block.iter_mut().enumerate() {
-                *o = f(c * CHUNK + k);
+                *o = f(c * BLOCK + k);
             }
         });
 }
@@ -57,8 +63,8 @@ pub fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync) {
 /// out[d][i] = f(i)[d] for every i: a per-particle vector result written into SoA components.
 pub fn fill_vector<const D: usize>(out: &mut [Vec<f64>; D], f: impl Fn(usize) -> [f64; D] + Sync) {
     let n = out[0].len();
-    let mut chunks = out.each_mut().map(|v| v.chunks_mut(CHUNK));
-    let blocks: Vec<[&mut [f64]; D]> = (0..n.div_ceil(CHUNK))
+    let mut chunks = out.each_mut().map(|v| v.chunks_mut(BLOCK));
+    let blocks: Vec<[&mut [f64]; D]> = (0..n.div_ceil(BLOCK))
         .map(|_| {
             chunks
                 .each_mut()
@@ -67,7 +73,7 @@ pub fn fill_vector<const D: usize>(out: &mut [Vec<f64>; D], f: impl Fn(usize) ->
         .collect();
     blocks.into_par_iter().enumerate().for_each(|(c, block)| {
         for k in 0..block[0].len() {
-            let v = f(c * CHUNK + k);
+            let v = f(c * BLOCK + k);
             for d in 0..D {
                 block[d][k] = v[d];
             }

@@ -43,6 +43,8 @@ struct SceneFile {
     checkpoint: CheckpointSection,
     #[serde(default)]
     effects: EffectsSection,
+    #[serde(default)]
+    walls: WallSettings,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -146,6 +148,26 @@ impl Default for SolverSettings {
             h_over_dx: 1.2,
         }
     }
+}
+
+/// The `[walls]` section: how the dummy wall particles carry the fluid's pressure.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(deny_unknown_fields, default)]
+pub struct WallSettings {
+    pub ghost_pressure: GhostPressure,
+}
+
+/// The pressure a wall particle b takes as the ghost of fluid particle i.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum GhostPressure {
+    /// P_b = P_i + ρ0 g·N_b (r_b − r_i): the Neumann condition of the projection,
+    /// ∂P/∂n = ρ0 g·n on a wall at rest (`wall`).
+    #[default]
+    Hydrostatic,
+    /// P_b = P_i: ∂P/∂n = 0, the walls mirror the fluid's pressure and hold no weight of
+    /// water (the simpler wall of the ablation, docs/stabilisation.md).
+    Mirror,
 }
 
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -285,6 +307,7 @@ pub struct Scene {
     pub solver: SolverSettings,
     pub checkpoint: CheckpointSettings,
     pub effects: Effects,
+    pub walls: WallSettings,
 }
 
 impl Scene {
@@ -573,6 +596,7 @@ impl Validator<'_> {
             solver: f.solver,
             checkpoint,
             effects,
+            walls: f.walls,
         })
     }
 

@@ -9,7 +9,7 @@ use crate::linsolve::{SolverError, SolverParams};
 use crate::memory::ArraySize;
 use crate::particles::Particles;
 use crate::reduce;
-use crate::scene::Scene;
+use crate::scene::{GhostPressure, Scene};
 use crate::step::{speed, StepReport, StepSettings, Workspace};
 use crate::timings::{Stage, Timings};
 use std::time::Instant;
@@ -117,6 +117,10 @@ impl<const D: usize> Simulation<D> {
             grid: CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
             settings: StepSettings {
                 gravity: std::array::from_fn(|d| scene.gravity[d]),
+                ghost_gravity: match scene.walls.ghost_pressure {
+                    GhostPressure::Hydrostatic => std::array::from_fn(|d| scene.gravity[d]),
+                    GhostPressure::Mirror => [0.0; D],
+                },
                 spacing: scene.spacing,
                 alpha: scene.solver.alpha,
                 solver: SolverParams {

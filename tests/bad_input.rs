@@ -111,6 +111,16 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             "end_time = [0.01",
             &["line 5", "TOML parse error", "expected `]`"],
         ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[walls]\nghost_pressure = \"sticky\"",
+            &[
+                "line 23",
+                "unknown variant `sticky`",
+                "hydrostatic",
+                "mirror",
+            ],
+        ),
     ];
     for (from, to, expected) in cases {
         let (code, stderr) = run_text(dir.path(), &good().replace(from, to), &[]);

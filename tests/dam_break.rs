@@ -5,7 +5,7 @@ use isph::validation::dam_break::Column;
 use isph::validation::{measure, Case};
 
 #[test]
-#[ignore = "known failure: the front leads Martin & Moyce by 12.7% mean relative error (bound 10%): a near-constant time lead of ~13 ms, converged in dx and dt (see the issue note)"]
+#[ignore = "known failure: the front leads Martin & Moyce by 12.4% mean relative error (bound 10%): a near-constant time lead of ~13 ms, converged in dx and dt (see the issue note)"]
 fn surge_front_follows_martin_and_moyce() {
     let mut scene = shipped_scene("dam_break_2d.toml");
     let column = Column::new(&scene).unwrap_or_else(|e| panic!("{e}"));

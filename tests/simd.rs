@@ -107,6 +107,7 @@ fn check<const D: usize>(n: i64) {
         row_vectors: &row_vectors,
         fluid_volume: &fluid_volume,
         gravity: [0.0; D],
+        ghost_gravity: [0.0; D],
     };
     let x: Vec<f64> = (0..nf).map(|i| phi(i) * phi(i)).collect();
     let mut ax = vec![0.0; nf];

@@ -11,6 +11,7 @@ For every scene it runs these variants (each a copy of the scene with one settin
     no-shifting           [effects.shifting] enabled = false
     no-kernel_correction  [effects.kernel_correction] enabled = false
     no-les                [effects.les] enabled = false
+    mirror-walls          [walls] ghost_pressure = "mirror" (a simpler wall: P_b = P_i)
 
 and prints one Markdown table row per variant, also written to OUT/ablation.md and OUT/ablation.csv:
 
@@ -48,6 +49,7 @@ def variants(scene: dict) -> dict:
         out[f"alpha={a:g}"] = with_key(scene, ["solver", "alpha"], a)
     for effect in ["shifting", "kernel_correction", "les"]:
         out[f"no-{effect}"] = with_key(scene, ["effects", effect], {"enabled": False})
+    out["mirror-walls"] = with_key(scene, ["walls", "ghost_pressure"], "mirror")
     return out
 
 
