@@ -26,6 +26,7 @@
 use crate::linsolve::{inverse_diagonal, LinearOperator, Preconditioner, SolverError};
 use crate::memory::ArraySize;
 use crate::reduce::fill;
+use rayon::prelude::*;
 
 /// Damping of the Jacobi smoother.
 const JACOBI_WEIGHT: f64 = 0.7;
@@ -249,7 +250,7 @@ impl<const D: usize> Multigrid<D> {
         }
         first
             .stencil
-            .chunks_mut(w)
+            .par_chunks_mut(w)
             .zip(&members)
             .for_each(|(row, members)| {
                 for &i in members {

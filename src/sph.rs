@@ -11,7 +11,7 @@ use wide::f64x4;
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
     let mut rho = f64x4::ZERO;
     nb.for_each_lanes(i, |l| {
-        rho = (l.load(&p.mass) * nb.kernel.w4(l.r) & l.mask) + rho;
+        rho = ((l.load(&p.mass) * nb.kernel.w4(l.r)) & l.mask) + rho;
     });
     p.mass[i] * nb.kernel.w(0.0) + rho.reduce_add()
 }

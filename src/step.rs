@@ -594,9 +594,7 @@ impl<const D: usize> Workspace<D> {
             let u = |l: &Lanes<D>| sph::fluid_velocity(p, u_i, l);
             let g = sph::velocity_gradient(nb, p, corrections.of(i), u_i, u, i);
             let dr = vector(shift, i);
-            let u =
-                std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>());
-            u
+            std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
         });
         let pressure_corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);

@@ -43,7 +43,7 @@ fn a_particle_inside_an_obstacle_leaves_through_the_nearest_face() {
     let obstacle = aabb([0.4, 0.0], [0.6, 0.3]);
     let (mut x, mut u) = ([0.45, 0.28], [0.2, -1.0]);
     assert_eq!(
-        faces(&[obstacle.clone()]).contact(0.01, &mut x, &mut u),
+        faces(std::slice::from_ref(&obstacle)).contact(0.01, &mut x, &mut u),
         Contact::Crossed
     );
     assert!(
