@@ -15,6 +15,7 @@ use crate::linsolve::LinearOperator;
 use crate::particles::{Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
 use crate::reduce::fill;
+use crate::reduce::in_pool;
 use crate::scene::{Scene, SceneError};
 use crate::simulation::{NoFluid, NumericalFailure, Simulation};
 use crate::sph::{Corrections, Neighbours};
@@ -168,6 +169,10 @@ pub struct Measurement {
 
 /// Runs one point in this process (the child's work), on the current rayon pool.
 pub fn measure_point(requested: usize, schedule: Schedule) -> Result<Measurement, BenchError> {
+    in_pool(|| measure_in_pool(requested, schedule))
+}
+
+fn measure_in_pool(requested: usize, schedule: Schedule) -> Result<Measurement, BenchError> {
     let scene = dam_break_scene(3, spacing_for(requested))?;
     let mut sim = Simulation::<3>::new(&scene)?;
     for _ in 0..schedule.warmup {

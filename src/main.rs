@@ -177,7 +177,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 quiet,
                 stop,
             };
-            let summary = in_pool(|| run(&scene, &opts))?;
+            let summary = run(&scene, &opts)?;
             if report {
                 print!("{}", RunReport::of_this_process()?.to_toml());
                 return Ok(());
@@ -218,7 +218,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 quiet,
                 stop,
             };
-            let summary = in_pool(|| isph::run::resume(&located.checkpoint, &opts))?;
+            let summary = isph::run::resume(&located.checkpoint, &opts)?;
             let state = &located.checkpoint.state;
             println!(
                 "resumed {} at step {} (t = {} s, last Δt = {:e} s): {} more steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in all, checkpoint {}",
@@ -316,7 +316,7 @@ fn bench_child(opts: &BenchOptions) -> anyhow::Result<()> {
         bail!("--child measures one point: give one size and one thread count");
     };
     start_threads(Some(threads))?;
-    let m = in_pool(|| bench::measure_point(size, opts.schedule))?;
+    let m = bench::measure_point(size, opts.schedule)?;
     print!("{}", m.to_toml());
     Ok(())
 }
@@ -332,13 +332,6 @@ fn start_threads(threads: Option<usize>) -> anyhow::Result<()> {
             .context("starting the thread pool")?;
     }
     Ok(())
-}
-
-/// Runs `f` on a worker thread of the global pool: a step's parallel loops (a few hundred, many
-/// of them short) then fork from inside the pool, the calling worker taking a share, instead of
-/// waking the pool from outside and sleeping until it is done.
-fn in_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    rayon::scope(|_| f())
 }
 
 fn check_until(until: Option<f64>) -> anyhow::Result<()> {

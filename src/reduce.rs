@@ -14,6 +14,14 @@ const CHUNK: usize = 2048;
 /// couple of thousand fluid particles (fewer than one `CHUNK`) still keeps every thread busy.
 const BLOCK: usize = 128;
 
+/// Runs `f` on a worker thread of the global pool (in place when called from one): a run's
+/// parallel loops (a few hundred a step, many of them short) then fork from inside the pool,
+/// the calling worker taking a share, instead of waking the pool from outside and sleeping until
+/// it is done.
+pub fn in_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| f())
+}
+
 /// Σ_i f(i) for i in 0..n, summed in fixed chunks (deterministic for any thread count).
 pub fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
     sums(n, |i| [f(i)])[0]

@@ -8,6 +8,7 @@ use crate::io::frames::{FrameInfo, FrameWriter};
 use crate::io::stats::StatsWriter;
 use crate::io::{prepare_output_dir, xdmf, OutputError};
 use crate::progress::Progress;
+use crate::reduce::in_pool;
 use crate::resume::{self, ResumeError, ResumeOptions};
 use crate::scene::Scene;
 use crate::simulation::{NoFluid, NumericalFailure, Simulation, StepStats};
@@ -106,11 +107,11 @@ pub struct RunSummary {
 }
 
 pub fn run(scene: &Scene, opts: &RunOptions) -> Result<RunSummary, RunError> {
-    match scene.dimensions {
+    in_pool(|| match scene.dimensions {
         2 => run_in::<2>(scene, opts),
         3 => run_in::<3>(scene, opts),
         d => unreachable!("scene validation admits 2 or 3 dimensions, not {d}"),
-    }
+    })
 }
 
 fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary, RunError> {
@@ -131,11 +132,11 @@ fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary
 /// Continues the run of `checkpoint` in its output directory (see `resume::prepare` for what is
 /// checked and what in the directory is replaced).
 pub fn resume(checkpoint: &Checkpoint, opts: &ResumeOptions) -> Result<RunSummary, RunError> {
-    match checkpoint.dimensions() {
+    in_pool(|| match checkpoint.dimensions() {
         2 => resume_in::<2>(checkpoint, opts),
         3 => resume_in::<3>(checkpoint, opts),
         d => unreachable!("a checkpoint that opened holds 2 or 3 dimensions, not {d}"),
-    }
+    })
 }
 
 fn resume_in<const D: usize>(
