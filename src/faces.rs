@@ -5,6 +5,7 @@
 //! a particle that crossed one (`contact`).
 
 use crate::scene::{Aabb, Scene};
+use crate::vector::{dot, norm, unit};
 
 /// The container and the obstacles of a scene.
 #[derive(Clone, Debug)]
@@ -155,23 +156,5 @@ impl Faces {
             let high = (o.max[d] < c.max[d]).then_some((d, 1.0, o.max[d]));
             low.into_iter().chain(high)
         })
-    }
-}
-
-fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
-    (0..D).map(|d| a[d] * b[d]).sum()
-}
-
-fn norm<const D: usize>(a: [f64; D]) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// a/|a|, or zero.
-fn unit<const D: usize>(a: [f64; D]) -> [f64; D] {
-    let len = norm(a);
-    if len > 0.0 {
-        a.map(|v| v / len)
-    } else {
-        a
     }
 }

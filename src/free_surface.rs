@@ -23,6 +23,7 @@
 //!    at impact speed and answers with a pressure spike that blows the spray apart.
 
 use crate::sph::Neighbours;
+use crate::vector::{dot, norm};
 
 /// λ_i at or below which a particle is free surface without the scan (Marrone et al.).
 const SPLASH_EIGENVALUE: f64 = 0.2;
@@ -54,7 +55,7 @@ impl<const D: usize> Support<D> {
     /// From the moment matrix M_i and the concentration gradient ∇C_i.
     pub fn new(m: &[[f64; D]; D], grad_c: [f64; D]) -> Self {
         let (lambda, axis) = min_eigenpair(m);
-        let len = dot(grad_c, grad_c).sqrt();
+        let len = norm(grad_c);
         let normal = if len > 0.0 {
             grad_c.map(|g| -g / len)
         } else {
@@ -108,10 +109,6 @@ fn in_umbrella<const D: usize>(rij: [f64; D], r: f64, n: [f64; D], h: f64) -> bo
     }
 }
 
-fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
-    (0..D).map(|d| a[d] * b[d]).sum()
-}
-
 /// Smallest eigenvalue of a symmetric D×D matrix (D ≤ 3) and a unit eigenvector of it.
 pub fn min_eigenpair<const D: usize>(m: &[[f64; D]; D]) -> (f64, [f64; D]) {
     let lambda = min_eigenvalue(m);
@@ -143,7 +140,7 @@ pub fn min_eigenpair<const D: usize>(m: &[[f64; D]; D]) -> (f64, [f64; D]) {
         .into_iter()
         .max_by(|a, b| dot(*a, *a).total_cmp(&dot(*b, *b)))
         .expect("at least one candidate");
-    let len = dot(best, best).sqrt();
+    let len = norm(best);
     if len > 0.0 {
         (lambda, best.map(|x| x / len))
     } else {

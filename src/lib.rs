@@ -32,4 +32,5 @@ pub mod study;
 pub mod timings;
 pub mod turbulence;
 pub mod validation;
+pub mod vector;
 pub mod wall;

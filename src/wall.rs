@@ -23,6 +23,7 @@
 use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::sph::Neighbours;
+use crate::vector::dot;
 use wide::{f64x4, CmpNe};
 
 /// P_b − P_i = −ρ0_i g·N_b r_ib of the ghost pressures of the wall particles b in lanes `l`
@@ -152,8 +153,4 @@ pub fn nearest_face<const D: usize>(
         normal,
         reach,
     })
-}
-
-pub fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
-    (0..D).map(|d| a[d] * b[d]).sum()
 }
