@@ -158,8 +158,9 @@ fn violent_impact_keeps_density_volume_and_order() {
     // The issue asks for < 1% at every step; at the default α = 0.1 the mean density error
     // stays below 0.5% until the plunging wave falls back, then exceeds 1% in 408 of 3,555
     // steps, 1.68% at worst (0.49% on average over the steps). The error is in the interior
-    // of the churning flow, not at the walls (docs/stabilisation.md). Bounds: 2% at every step,
-    // 0.75% on average.
+    // of the churning flow, not at the walls (docs/stabilisation.md). The worst step is chaotic
+    // (frames every 0.01 s instead of 0.05 s: 1.13%, 6 steps above 1%), the mean is not (0.44%).
+    // Bounds: 2% at every step, 0.75% on average.
     let worst = density.iter().cloned().fold(0.0, f64::max);
     let average = density.iter().sum::<f64>() / density.len() as f64;
     assert!(worst < 0.02, "mean density error reached {worst}");
