@@ -126,7 +126,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
             "Eq. (7): u = u* − (Δt/ρ0)∇P, ∇P {} with the walls as ghosts; no velocity into a wall face within half a spacing of it",
             if effects.kernel_correction { "corrected by L'_i (Eq. 20, 24–25)" } else { "of Eq. (20)" }
         ),
-        Stage::WallPressure => "pressure of the wall particles (output): kernel mean of the ghost pressures of their fluid neighbours".into(),
+        Stage::WallPressure => "pressure of the wall particles, on the steps that end on a frame: kernel mean of the ghost pressures of their fluid neighbours".into(),
         Stage::Shifting => {
             let s = effects.shifting.unwrap_or_default();
             format!(

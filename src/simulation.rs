@@ -198,8 +198,10 @@ impl<const D: usize> Simulation<D> {
         Ok(())
     }
 
-    /// Advances by one step towards the simulated time `target`, landing on it exactly when it
-    /// is within reach (two steps to go are split evenly, so no step is tiny).
+    /// Advances by one step towards the simulated time `target` (the next frame's), landing on
+    /// it exactly when it is within reach (two steps to go are split evenly, so no step is
+    /// tiny). The step that lands on it also computes the wall particles' pressure for the
+    /// frame.
     pub fn advance_towards(&mut self, target: f64) -> Result<StepStats, NumericalFailure> {
         self.sort_by_cell()?;
         let limit = self.time_step_limit()?;
@@ -221,6 +223,7 @@ impl<const D: usize> Simulation<D> {
                 &self.settings,
                 &self.faces,
                 dt,
+                dt == remaining,
                 &mut self.timings,
             )
             .map_err(|source| NumericalFailure::Solver { step, time, source })?;

@@ -78,7 +78,7 @@ pub struct Ghosts<'a, const D: usize> {
 }
 
 impl<const D: usize> Ghosts<'_, D> {
-    /// Pressure of wall particle b for output and wall loads: the kernel-weighted mean of the
+    /// Pressure of wall particle b for the frames: the kernel-weighted mean of the
     /// ghost pressures its fluid neighbours give it (zero where no fluid is in reach), with
     /// `fluid_pressure` the pressures of the fluid particles.
     pub fn wall_pressure(&self, nb: &Neighbours<D>, fluid_pressure: &[f64], b: usize) -> f64 {
