@@ -213,6 +213,7 @@ impl<const D: usize> Simulation<D> {
         } else {
             limit
         };
+        let lands_on_target = dt == remaining;
         let (step, time) = (self.step, self.time);
         let report = self
             .work
@@ -223,11 +224,11 @@ impl<const D: usize> Simulation<D> {
                 &self.settings,
                 &self.faces,
                 dt,
-                dt == remaining,
+                lands_on_target,
                 &mut self.timings,
             )
             .map_err(|source| NumericalFailure::Solver { step, time, source })?;
-        self.time = if dt == remaining {
+        self.time = if lands_on_target {
             target
         } else {
             self.time + dt
