@@ -4,6 +4,9 @@
 //! projection step of [`simulation::Simulation`]; [`run`] drives a whole run with its output
 //! and checkpoints, and continues one from a checkpoint ([`resume`]).
 
+// Axis and tensor loops index several arrays by the same d (or a, b), as the equations do.
+#![allow(clippy::needless_range_loop)]
+
 pub mod bench;
 pub mod child;
 pub mod faces;

@@ -6,6 +6,8 @@ use crate::reduce::{dot, fill};
 use rayon::prelude::*;
 
 /// A square linear operator y = A x that is applied, never stored.
+// Its size is the number of unknowns; an operator of none is never built.
+#[allow(clippy::len_without_is_empty)]
 pub trait LinearOperator: Sync {
     fn len(&self) -> usize;
     fn apply(&self, x: &[f64], y: &mut [f64]);

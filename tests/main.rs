@@ -1,5 +1,8 @@
 //! One integration-test binary (habit 7 of STYLE.md): physics, numerics, output and bad input.
 
+// Matrix and axis loops index several arrays by the same index, as the equations do.
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 
 mod bad_input;
