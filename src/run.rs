@@ -18,6 +18,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
+/// Frame times within this many output intervals of the end time are the end time.
+const FRAME_TIME_ROUNDING: f64 = 1e-6;
+
 /// Set to a signal number (by a signal handler, or by any thread) to stop a run after its
 /// current step: it then writes a checkpoint and returns `RunError::Interrupted`.
 pub type StopSignal = Arc<AtomicUsize>;
@@ -236,16 +239,26 @@ impl<'a, const D: usize> Driver<'a, D> {
         Some(((time / interval).floor() + 1.0) * interval)
     }
 
-    /// The scheduled time of the next frame, and the next frame's time: that one, or the end
-    /// time if it comes first.
-    fn next_frame_time(&self) -> (f64, f64) {
-        let scheduled = self.next_output as f64 * self.scene.output_interval;
-        (scheduled, scheduled.min(self.end))
+    /// The next frame's time, and whether writing it there is the scheduled frame
+    /// `next_output × output_interval`: the scheduled time, or the end time if it comes first.
+    /// A scheduled time within `FRAME_TIME_ROUNDING` intervals of the end time is the end time
+    /// (0.03 × 11 = 0.32999999999999996 against an end time of 0.33), so that no step is
+    /// shortened to a sliver between the two: a step of 1e-17 s makes the pressure solve's
+    /// 1/Δt² terms blow the flow up.
+    fn next_frame(&self) -> (f64, bool) {
+        let interval = self.scene.output_interval;
+        let scheduled = self.next_output as f64 * interval;
+        let rounding = FRAME_TIME_ROUNDING * interval;
+        if scheduled < self.end - rounding {
+            (scheduled, true)
+        } else {
+            (self.end, scheduled <= self.end + rounding)
+        }
     }
 
     /// Writes a frame when the simulation has reached the next frame time.
     fn write_frame_if_due(&mut self) -> Result<(), RunError> {
-        let (scheduled, target) = self.next_frame_time();
+        let (target, scheduled) = self.next_frame();
         if self.sim.time < target {
             return Ok(());
         }
@@ -258,7 +271,7 @@ impl<'a, const D: usize> Driver<'a, D> {
         xdmf::write(&o.dir, &o.frames)?;
         o.stats.flush()?;
         // A frame at the end time before the scheduled one leaves that one due.
-        if self.sim.time >= scheduled {
+        if scheduled {
             self.next_output += 1;
         }
         Ok(())
@@ -314,7 +327,7 @@ impl<'a, const D: usize> Driver<'a, D> {
         let mut progress = Progress::new(self.sim.time, self.sim.step, self.end, self.quiet);
         let (mut steps, mut ppe_total, mut last) = (0u64, 0u64, None);
         while self.sim.time < self.end {
-            let (_, target) = self.next_frame_time();
+            let (target, _) = self.next_frame();
             let step = match self.sim.advance_towards(target) {
                 Ok(s) => s,
                 Err(failure) => {

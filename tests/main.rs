@@ -11,6 +11,7 @@ mod checkpoint;
 mod dam_break;
 mod determinism;
 mod effects;
+mod frame_times;
 mod free_surface;
 mod hydrostatic;
 mod kernel;

@@ -1,0 +1,42 @@
+//! Frame times: every multiple of `output_interval` and the end time, with a multiple that
+//! rounds to within a sliver of the end time taken for the end time (11 × 0.03 =
+//! 0.32999999999999996 against 0.33), so that no step is cut to a sliver (a step of 5e-17 s
+//! blew the flow up: max speed 4e12 m/s, and the end checkpoint held that state).
+
+use crate::common::{run_scene, stats_column, water_block_scene, TempDir};
+use isph::scene::Scene;
+use std::path::Path;
+
+fn scene(end_time: f64, interval: f64) -> Scene {
+    let text = water_block_scene(end_time).replace(
+        "output_interval = 0.02",
+        &format!("output_interval = {interval}"),
+    );
+    Scene::parse(&text, Path::new("frames.toml")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Runs to `until`, checks the frame times against `expected` and that no step was a sliver.
+fn assert_frames(end_time: f64, interval: f64, until: f64, expected: &[f64]) {
+    let dir = TempDir::new("frame_times");
+    let summary = run_scene(&scene(end_time, interval), dir.path(), until);
+    let times: Vec<f64> = summary.frames.iter().map(|f| f.time).collect();
+    assert_eq!(times, expected, "frame times");
+    let shortest = stats_column(dir.path(), "dt")
+        .into_iter()
+        .fold(f64::MAX, f64::min);
+    assert!(shortest > 1e-4, "a step of {shortest:e} s");
+    // The water falls from 0.2 m at most: √(2 g 0.2) = 2 m/s, splashes a bit faster.
+    let fastest = stats_column(dir.path(), "max_speed")
+        .into_iter()
+        .fold(0.0, f64::max);
+    assert!(fastest < 4.0, "max speed {fastest} m/s");
+}
+
+#[test]
+fn a_frame_time_that_rounds_next_to_the_end_time_is_the_end_time() {
+    let mut expected: Vec<f64> = (0..11).map(|k| k as f64 * 0.03).collect();
+    expected.push(0.33);
+    assert_frames(0.33, 0.03, 0.33, &expected);
+    // The same past a frame: `--until` a sliver after 0.04 ends there, with no frame at 0.04.
+    assert_frames(0.1, 0.02, 0.04000000000001, &[0.0, 0.02, 0.04000000000001]);
+}
