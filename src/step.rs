@@ -468,6 +468,7 @@ impl<const D: usize> Workspace<D> {
         };
         ppe::source(
             &op,
+            self.reference.is_some(),
             &self.full_support,
             set.spacing,
             Corrections::sparse(kernel_correction, &self.correction_slot, &self.corrections),
@@ -476,9 +477,6 @@ impl<const D: usize> Workspace<D> {
             set.alpha,
             &mut self.rhs,
         );
-        if self.reference.is_some() {
-            ppe::remove_net_compression(&self.roles, &mut self.rhs);
-        }
         let roles = &self.roles;
         // In a closed box the last pressure is shifted to the new reference's level.
         let level = self.reference.map_or(0.0, |r| p.pressure[r]);
