@@ -278,9 +278,11 @@ impl<const D: usize> PpeSetup<D> {
         fill(&mut roles, |i| Role::from_code(p.free_surface[i]));
         let mut row_vectors = std::array::from_fn(|_| vec![0.0; nf]);
         let nb = Neighbours::new(&grid, &p.pos, kernel);
+        // The dam break holds one fluid: no interfaces.
         ppe::row_vectors(
             &nb,
             p,
+            false,
             &roles,
             Corrections::new(false, &[]),
             &mut row_vectors,
@@ -313,6 +315,7 @@ impl<const D: usize> PpeSetup<D> {
             fluid_volume: &self.fluid_volume,
             gravity,
             ghost_gravity: gravity,
+            interfaces: false,
         }
     }
 

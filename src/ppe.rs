@@ -20,7 +20,7 @@ use crate::multigrid::{stencil_slot, Aggregated};
 use crate::neighbours::{Lanes, LANES};
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
-use crate::sph::{velocity_gradient, Correction, Corrections, Neighbours};
+use crate::sph::{interface_weight, velocity_gradient, Correction, Corrections, Neighbours};
 use crate::wall::{behind_walls, ghost_pressure_difference, ghost_velocity};
 use rayon::prelude::*;
 use wide::f64x4;
@@ -144,12 +144,13 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 pub fn row_vectors<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    interfaces: bool,
     roles: &[Role],
     pressure_corrections: Corrections<D>,
     out: &mut [Vec<f64>; D],
 ) {
     fill_vector(out, |i| match roles[i] {
-        Role::Interior => laplacian_correction(nb, p, pressure_corrections.of(i), i),
+        Role::Interior => laplacian_correction(nb, p, interfaces, pressure_corrections.of(i), i),
         Role::Surface | Role::Splash | Role::Reference => [0.0; D],
     });
 }
@@ -262,6 +263,31 @@ fn divergence_source<const D: usize>(
     -(rho0 / dt * div + density_term)
 }
 
+/// m̃_j, the mass neighbour j counts with in the Laplacian row of particle i (Eq. 27): m_j
+/// where the fluids share one rest density. Where they do not (`interfaces`), row i is
+/// ρ0_i ∇·(∇P/ρ) with the harmonic mean 2/(ρ0_i + ρ0_j) of 1/ρ across a pair (Cummins &
+/// Rudman 1999), which keeps ∇P/ρ continuous across an interface and a stable layering at
+/// rest: a_ij = −2 V_j (2ρ0_i/(ρ0_i + ρ0_j)) r_ij·∇W_ij/(r_ij² + η²), i.e.
+/// m̃_j = m_j 2ρ0_i²/(ρ0_j (ρ0_i + ρ0_j)); a wall ghost is one of i's own fluid,
+/// m̃_b = m_b ρ0_i/ρ0_b = ρ0_i V_b. Both are exactly m_j where ρ0_j = ρ0_i.
+#[inline(always)]
+fn laplacian_mass<const D: usize>(
+    p: &Particles<D>,
+    interfaces: bool,
+    rest_density: f64x4,
+    l: &Lanes<D>,
+) -> f64x4 {
+    let mass = l.load(&p.mass);
+    if !interfaces {
+        return mass;
+    }
+    let (rho_i, rho_j) = (rest_density, l.load(&p.rest_density));
+    match l.kind {
+        Kind::Fluid => mass * (interface_weight(rho_i, rho_j) * (rho_i / rho_j)),
+        Kind::Wall => mass * (rho_i / rho_j),
+    }
+}
+
 /// First-order consistency of the Laplacian of Eq. (27). Where the free surface truncates the
 /// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with
 /// c_i = 2 Σ_j (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support). A wall ghost
@@ -276,15 +302,18 @@ fn divergence_source<const D: usize>(
 fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    interfaces: bool,
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
     let mut c = [f64x4::ZERO; D];
     let scale = f64x4::splat(2.0 / p.rest_density[i]);
+    let rest_density = f64x4::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |lanes| {
         let (_, laplacian_factor) = nb.gradient_and_laplacian_factors4(lanes.r);
         // −a_ij of Eq. (27) (`sph::laplacian_coefficient`).
-        let cl = (scale * lanes.load(&p.mass) * laplacian_factor) & lanes.mask;
+        let mass = laplacian_mass(p, interfaces, rest_density, lanes);
+        let cl = (scale * mass * laplacian_factor) & lanes.mask;
         let followed = match lanes.kind {
             Kind::Fluid => lanes.rij,
             Kind::Wall => behind_walls(p, lanes, lanes.rij),
@@ -312,12 +341,16 @@ pub struct PressureOperator<'a, const D: usize> {
     pub gravity: [f64; D],
     /// The gravity the wall ghosts' pressures carry (`StepSettings::ghost_gravity`).
     pub ghost_gravity: [f64; D],
+    /// The fluids differ in rest density (`laplacian_mass`).
+    pub interfaces: bool,
 }
 
 /// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
 struct Row<const D: usize> {
     scale: f64x4,
     c: [f64x4; D],
+    /// ρ0_i.
+    rest_density: f64x4,
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
@@ -325,12 +358,13 @@ impl<const D: usize> PressureOperator<'_, D> {
         Row {
             scale: f64x4::splat(-2.0 / self.p.rest_density[i]),
             c: std::array::from_fn(|d| f64x4::splat(self.row_vectors[d][i])),
+            rest_density: f64x4::splat(self.p.rest_density[i]),
         }
     }
 
     /// Weights of (P_i − P_j) in the interior row i (constants `row`) for the lanes `l`, with
-    /// `mass` and `volume` the masses m_j and volumes V_j of the lanes:
-    /// max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
+    /// `mass` and `volume` the masses m̃_j (`laplacian_mass`) and volumes V_j of the lanes:
+    /// max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij = −(2 m̃_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
     #[inline(always)]
     fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, mass: f64x4, volume: f64x4) -> f64x4 {
         let (f, laplacian_factor) = self.nb.gradient_and_laplacian_factors4(l.r);
@@ -346,7 +380,8 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// The weights of interior row i with its fluid neighbours `l`.
     #[inline(always)]
     fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> f64x4 {
-        self.interior_weights(row, l, l.load(&self.p.mass), l.load(self.fluid_volume))
+        let mass = laplacian_mass(self.p, self.interfaces, row.rest_density, l);
+        self.interior_weights(row, l, mass, l.load(self.fluid_volume))
     }
 
     /// The wall part of the right-hand side of interior row i: the Neumann ghosts' known
@@ -355,8 +390,9 @@ impl<const D: usize> PressureOperator<'_, D> {
         let (p, row) = (self.p, self.row_constants(i));
         let mut b = f64x4::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
-            let mass = l.load(&p.mass);
-            let w = self.interior_weights(&row, l, mass, mass / l.load(&p.rest_density));
+            let volume = l.load(&p.mass) / l.load(&p.rest_density);
+            let mass = laplacian_mass(p, self.interfaces, row.rest_density, l);
+            let w = self.interior_weights(&row, l, mass, volume);
             b += w * ghost_pressure_difference(p, self.ghost_gravity, i, l);
         });
         b.reduce_add()

@@ -129,6 +129,10 @@ impl<const D: usize> Simulation<D> {
                 },
                 effects: scene.effects,
                 confined,
+                interfaces: scene
+                    .fluids
+                    .iter()
+                    .any(|f| f.density != scene.fluids[0].density),
             },
             faces: Faces::new(scene),
             cfl: scene.solver.cfl,

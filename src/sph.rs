@@ -7,13 +7,29 @@ use crate::particles::{Kind, Particles};
 use crate::wall::{behind_walls, ghost_velocity, Face};
 use wide::f64x4;
 
-/// Summation density ρ_i = Σ_j m_j W_ij (self included).
+/// Summation density ρ_i = Σ_j m_j (ρ0_i/ρ0_j) W_ij = ρ0_i Σ_j V_j W_ij (self included): the
+/// familiar Σ_j m_j W_ij where the support holds one fluid, while across the interface of two
+/// fluids each neighbour counts with its volume (Hu & Adams 2006), so that water beside oil
+/// is not taken for expanded (below 0.9 ρ0 it would be spray) nor the oil for compressed.
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
     let mut rho = f64x4::ZERO;
+    let rho0_i = f64x4::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |l| {
-        rho = ((l.load(&p.mass) * nb.kernel.w4(l.r)) & l.mask) + rho;
+        let mass = l.load(&p.mass) * (rho0_i / l.load(&p.rest_density));
+        rho = ((mass * nb.kernel.w4(l.r)) & l.mask) + rho;
     });
     p.mass[i] * nb.kernel.w(0.0) + rho.reduce_add()
+}
+
+/// 2ρ0_i/(ρ0_i + ρ0_j): across a pair of fluids, the harmonic mean 2/(ρ0_i + ρ0_j) of 1/ρ
+/// relative to particle i's own 1/ρ0_i; exactly 1 within one fluid. The pressure a pair sees
+/// across an interface is then that of the interface between them, with ∇P/ρ continuous
+/// through it (Hu & Adams 2006; Cummins & Rudman 1999): in a stable layering at rest
+/// ∇P_i/ρ0_i = g on both sides, where the plain difference P_j − P_i averages the two
+/// fluids' hydrostatic gradients and pushes the particles beside the interface.
+#[inline(always)]
+pub fn interface_weight(rest_density_i: f64x4, rest_density_j: f64x4) -> f64x4 {
+    f64x4::splat(2.0) * rest_density_i / (rest_density_i + rest_density_j)
 }
 
 /// V_j F(r_ij) of the lanes (zero in the masked ones), with V_j = m_j/ρ0_j: the weight of

@@ -47,6 +47,9 @@ pub struct StepSettings<const D: usize> {
     /// The fluid fills a closed or periodic container (`lattice::fills_container`): it has no
     /// free surface, and none is looked for.
     pub confined: bool,
+    /// The fluids differ in rest density: the PPE rows weigh pairs across an interface
+    /// (`ppe::laplacian_mass`).
+    pub interfaces: bool,
 }
 
 /// The stages of a step of a scene with `effects`, in order: those of `Workspace::project`,
@@ -452,6 +455,7 @@ impl<const D: usize> Workspace<D> {
         ppe::row_vectors(
             nb,
             p,
+            set.interfaces,
             &self.roles,
             Corrections::new(kernel_correction, &self.pressure_corrections),
             &mut self.row_vectors,
@@ -465,6 +469,7 @@ impl<const D: usize> Workspace<D> {
             fluid_volume: &self.fluid_volume,
             gravity: set.gravity,
             ghost_gravity: set.ghost_gravity,
+            interfaces: set.interfaces,
         };
         ppe::source(
             &op,
@@ -663,7 +668,8 @@ fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
 }
 
 /// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25) and the walls as
-/// ghosts of its pressure (see `wall`) carrying `ghost_gravity`.
+/// ghosts of its pressure (see `wall`) carrying `ghost_gravity`; across the interface of two
+/// fluids each difference is weighted by `sph::interface_weight`.
 fn pressure_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
@@ -671,9 +677,12 @@ fn pressure_gradient<const D: usize>(
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    let p_i = f64x4::splat(p.pressure[i]);
+    let (p_i, rest_density) = (f64x4::splat(p.pressure[i]), f64x4::splat(p.rest_density[i]));
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
-        Kind::Fluid => lanes.load(&p.pressure) - p_i,
+        Kind::Fluid => {
+            let weight = sph::interface_weight(rest_density, lanes.load(&p.rest_density));
+            (lanes.load(&p.pressure) - p_i) * weight
+        }
         Kind::Wall => wall::ghost_pressure_difference(p, ghost_gravity, i, lanes),
     })
 }
