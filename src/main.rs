@@ -11,9 +11,30 @@ use isph::scene::Scene;
 use isph::study::{plot, StudyOptions};
 use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::flag;
+use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
+
+/// `print!` to stdout, where a reader that has gone away (`isph plan x | head -2`) is not an
+/// error: the output is dropped, the command carries on (a run still writes its checkpoint).
+macro_rules! out {
+    ($($arg:tt)*) => { write_stdout(format_args!($($arg)*)) };
+}
+
+/// `println!` to stdout, as `out!`.
+macro_rules! outln {
+    ($($arg:tt)*) => { write_stdout(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+fn write_stdout(text: std::fmt::Arguments) {
+    match std::io::stdout().write_fmt(text) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("warning: writing to stdout: {e}")
+        }
+        _ => {}
+    }
+}
 
 #[derive(Parser)]
 #[command(
@@ -179,10 +200,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             };
             let summary = run(&scene, &opts)?;
             if report {
-                print!("{}", RunReport::of_this_process()?.to_toml());
+                out!("{}", RunReport::of_this_process()?.to_toml());
                 return Ok(());
             }
-            println!(
+            outln!(
                 "{}: {} steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in {}, checkpoint {}",
                 scene.name,
                 summary.steps,
@@ -193,7 +214,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 out.display(),
                 summary.checkpoint.path.display()
             );
-            println!("time per stage: {}", summary.timings);
+            outln!("time per stage: {}", summary.timings);
             Ok(())
         }
         Command::Resume {
@@ -220,7 +241,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             };
             let summary = isph::run::resume(&located.checkpoint, &opts)?;
             let state = &located.checkpoint.state;
-            println!(
+            outln!(
                 "resumed {} at step {} (t = {} s, last Δt = {:e} s): {} more steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in all, checkpoint {}",
                 located.checkpoint.path().display(),
                 state.step,
@@ -233,12 +254,12 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 summary.frames.len(),
                 summary.checkpoint.path.display()
             );
-            println!("time per stage: {}", summary.timings);
+            outln!("time per stage: {}", summary.timings);
             Ok(())
         }
         Command::Plan { scene } => {
             let scene = Scene::load(&scene)?;
-            println!("{}", Plan::new(&scene)?);
+            outln!("{}", Plan::new(&scene)?);
             Ok(())
         }
         Command::Measure {
@@ -249,9 +270,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let case: isph::validation::Case = measure.parse()?;
             let scene = Scene::load(&scene)?;
             let measured = isph::validation::measure(case, &scene, &run)?;
-            println!("error = {:e}", measured.error);
+            outln!("error = {:e}", measured.error);
             for (name, value) in &measured.details {
-                println!("{name} = {value:e}");
+                outln!("{name} = {value:e}");
             }
             Ok(())
         }
@@ -266,15 +287,15 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let exe = std::env::current_exe().context("locating the isph executable")?;
             let opts = StudyOptions { out, threads };
             let summary = isph::study::run(&study, &opts, &exe, |line| eprintln!("{line}"))?;
-            print!("{}", plot::table(&summary.outcomes));
+            out!("{}", plot::table(&summary.outcomes));
             if summary.complete {
-                println!(
+                outln!(
                     "written: {} and {}",
                     summary.csv().display(),
                     summary.svg().display()
                 );
             } else {
-                println!(
+                outln!(
                     "{} of the study's points are done (the others are being run by another isph study); {} is written when all are",
                     summary.outcomes.len(),
                     summary.svg().display()
@@ -301,9 +322,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             let exe = std::env::current_exe().context("locating the isph executable")?;
             let rows = bench::run(&opts, &exe, |line| eprintln!("{line}"))?;
-            print!("{}", bench::table(&rows, opts.schedule));
+            out!("{}", bench::table(&rows, opts.schedule));
             if let Some(csv) = &opts.csv {
-                println!("written: {}", csv.display());
+                outln!("written: {}", csv.display());
             }
             Ok(())
         }
@@ -317,7 +338,7 @@ fn bench_child(opts: &BenchOptions) -> anyhow::Result<()> {
     };
     start_threads(Some(threads))?;
     let m = bench::measure_point(size, opts.schedule)?;
-    print!("{}", m.to_toml());
+    out!("{}", m.to_toml());
     Ok(())
 }
 

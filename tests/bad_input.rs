@@ -180,3 +180,30 @@ fn an_existing_run_is_never_overwritten_by_accident() {
     let (code, stderr) = run_text(dir.path(), &good(), &["--overwrite"]);
     assert_eq!(code, 0, "{stderr}");
 }
+
+/// `isph plan x | head -1`, `isph run x | true`: a reader of stdout that has gone away is not
+/// an error (it was a panic: "failed printing to stdout: Broken pipe").
+#[test]
+fn a_closed_stdout_is_not_an_error() {
+    let dir = TempDir::new("closed-stdout");
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, good()).unwrap();
+    let out = dir.path().join("out");
+    let (scene, out) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    for args in [vec!["plan", scene], vec!["run", scene, "--out", out, "-q"]] {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = isph_command().args(&args).stdout(writer).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "isph {args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "isph {args:?}: {stderr}");
+    }
+    assert!(
+        dir.path()
+            .join("out/checkpoints")
+            .read_dir()
+            .unwrap()
+            .count()
+            > 0
+    );
+}
