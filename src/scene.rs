@@ -572,7 +572,20 @@ impl Validator<'_> {
         let effects = self.effects(&f.effects)?;
 
         let name = match &s.name {
-            Some(n) => n.clone(),
+            Some(n) => {
+                // The run goes to out/<name>: one plain directory name, not a path.
+                let plain = !n.is_empty()
+                    && n != "."
+                    && n != ".."
+                    && !n.contains(['/', '\\'])
+                    && n.trim() == n;
+                self.check(
+                    plain,
+                    "simulation.name",
+                    format!("= \"{n}\" must be a plain directory name (the run goes to out/<name>): not empty, no '/', not \".\" or \"..\", no surrounding spaces"),
+                )?;
+                n.clone()
+            }
             None => self
                 .path
                 .file_stem()

@@ -58,6 +58,16 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             &["simulation.dimensions", "scene.toml:2", "2 or 3"],
         ),
         (
+            "dimensions = 2",
+            "dimensions = 2\nname = \"../../elsewhere\"",
+            &["simulation.name", "scene.toml:3", "plain directory name"],
+        ),
+        (
+            "dimensions = 2",
+            "dimensions = 2\nname = \"\"",
+            &["simulation.name", "scene.toml:3", "plain directory name"],
+        ),
+        (
             "gravity = [0.0, -9.81]",
             "gravity = [0.0, -9.81, 0.0]",
             &["simulation.gravity", ":6", "3 components"],
