@@ -411,7 +411,8 @@ impl Validator<'_> {
         self.vector(&b.max, dims, &format!("{key}.max"))?;
         for d in 0..dims {
             self.check(
-                b.max[d] - b.min[d] >= spacing,
+                // (0.21 − 0.2 = 0.00999… is one spacing of 0.01)
+                b.max[d] - b.min[d] >= spacing * (1.0 - 1e-9),
                 &format!("{key}.max"),
                 format!(
                     "must exceed `{key}.min` by at least one particle spacing ({spacing} m) in every axis; axis {d} has {} .. {}",

@@ -217,3 +217,19 @@ fn a_closed_stdout_is_not_an_error() {
             > 0
     );
 }
+
+/// A block one spacing wide holds one particle per axis, whatever the rounding of its corners
+/// (0.3 − 0.28 = 0.01999… was refused as narrower than the spacing 0.02).
+#[test]
+fn a_block_one_spacing_wide_is_accepted() {
+    let text = good()
+        .replace(
+            "min = [0.0, 0.0]\nmax = [0.2, 0.2]",
+            "min = [0.28, 0.1]\nmax = [0.3, 0.12]",
+        )
+        .replace("spacing = 0.02", "spacing = 0.02\nname = \"one\"");
+    let scene =
+        isph::scene::Scene::parse(&text, Path::new("one.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let plan = isph::plan::Plan::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+    assert!(plan.to_string().contains("particles: 1 fluid"), "{plan}");
+}
