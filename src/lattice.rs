@@ -11,6 +11,29 @@ pub fn wall_layers(scene: &Scene) -> usize {
     (SUPPORT_IN_H * scene.solver.h_over_dx - 1e-9).ceil() as usize
 }
 
+/// At least as many particles as `build` makes, fluid and wall, counted without making them
+/// (blocks and obstacles as if none overlapped another): a scene too large for the machine is
+/// refused before its particles fill the memory.
+pub fn particle_bound(scene: &Scene) -> f64 {
+    let dx = scene.spacing;
+    let points = |b: &crate::scene::Aabb| -> f64 {
+        (0..scene.dimensions)
+            .map(|d| ((b.max[d] - b.min[d]) / dx).ceil() + 1.0)
+            .product()
+    };
+    let layers = wall_layers(scene) as f64;
+    let inside = points(&scene.container);
+    let with_walls: f64 = (0..scene.dimensions)
+        .map(|d| {
+            let cells = ((scene.container.max[d] - scene.container.min[d]) / dx).ceil() + 1.0;
+            cells + if scene.periodic[d] { 0.0 } else { 2.0 * layers }
+        })
+        .product();
+    let fluid: f64 = scene.blocks.iter().map(|b| points(&b.region)).sum();
+    let obstacles: f64 = scene.obstacles.iter().map(points).sum();
+    fluid.min(inside) + (with_walls - inside) + obstacles.min(inside)
+}
+
 /// Particles of the scene at t = 0: fluid first (in block order), then walls.
 pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let dx = scene.spacing;

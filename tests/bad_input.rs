@@ -53,6 +53,21 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             &["simulation.spacing", "scene.toml:3", "positive"],
         ),
         (
+            "spacing = 0.02",
+            "spacing = 1e-9",
+            &[
+                "simulation.spacing",
+                "scene.toml:3",
+                "particles",
+                "more than",
+            ],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [1e6, 0.3]",
+            &["simulation.spacing", "GiB of memory available"],
+        ),
+        (
             "dimensions = 2",
             "dimensions = 4",
             &["simulation.dimensions", "scene.toml:2", "2 or 3"],
