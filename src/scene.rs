@@ -285,6 +285,9 @@ pub struct Block {
     pub region: Aabb,
 }
 
+/// Frames a scene may ask for, at most (end_time / output_interval).
+const MAX_FRAMES: f64 = 1e5;
+
 /// Peak resident memory of a run per particle, walls included, with margin: 380–490 B measured
 /// on the 3D dam break from 10⁴ to 10⁶ particles (docs/performance.md).
 const PEAK_BYTES_PER_PARTICLE: f64 = 600.0;
@@ -477,6 +480,15 @@ impl Validator<'_> {
         self.positive(s.spacing, "simulation.spacing", "m")?;
         self.positive(s.end_time, "simulation.end_time", "s")?;
         self.positive(s.output_interval, "simulation.output_interval", "s")?;
+        let frames = s.end_time / s.output_interval;
+        self.check(
+            frames <= MAX_FRAMES,
+            "simulation.output_interval",
+            format!(
+                "= {} makes {frames:.3e} frames to end_time = {} s; at most {MAX_FRAMES} (each frame holds every particle)",
+                s.output_interval, s.end_time
+            ),
+        )?;
         self.vector(&s.gravity, dims, "simulation.gravity")?;
 
         self.check(

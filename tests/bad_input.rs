@@ -53,6 +53,11 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             &["simulation.spacing", "scene.toml:3", "positive"],
         ),
         (
+            "output_interval = 0.01",
+            "output_interval = 1e-12",
+            &["simulation.output_interval", "scene.toml:5", "frames"],
+        ),
+        (
             "spacing = 0.02",
             "spacing = 1e-9",
             &[
