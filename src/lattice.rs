@@ -42,13 +42,14 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let cells = container_cells::<D>(scene);
     let point = |k: [i64; D]| lattice_point(scene, k);
     let in_obstacle = |x: &[f64; D]| in_obstacle(scene, x);
+    let near_obstacle = |x: &[f64; D]| near_obstacle(scene, x);
 
     let mut particles = Particles::<D>::default();
     // A lattice point belongs to the first block that contains it.
     for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
         let x = point(k);
         let block = scene.blocks.iter().find(|b| b.region.contains(&x));
-        if let (Some(b), false) = (block, in_obstacle(&x)) {
+        if let (Some(b), false) = (block, near_obstacle(&x)) {
             let fluid = &scene.fluids[b.fluid];
             particles.push(NewParticle {
                 pos: x,
@@ -106,7 +107,7 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
 pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) -> bool {
     let mut room = 0;
     for_each_lattice_point([0; D], container_cells::<D>(scene), |k| {
-        room += !in_obstacle(scene, &lattice_point(scene, k)) as usize;
+        room += !near_obstacle(scene, &lattice_point(scene, k)) as usize;
     });
     particles.fluid_count() == room
 }
@@ -125,6 +126,19 @@ fn lattice_point<const D: usize>(scene: &Scene, k: [i64; D]) -> [f64; D] {
 
 fn in_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
     scene.obstacles.iter().any(|o| o.contains(x))
+}
+
+/// Whether x lies inside an obstacle or less than half a spacing outside it: no fluid particle
+/// starts there. With the obstacle's faces between lattice points (container.min + k dx) the
+/// nearest fluid is half a spacing off, as at the container's walls; a face through lattice
+/// points would otherwise put fluid on the face itself, pushed back and counted as crossing it
+/// in the first step.
+fn near_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
+    let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
+    scene
+        .obstacles
+        .iter()
+        .any(|o| (0..D).all(|d| x[d] > o.min[d] - margin && x[d] < o.max[d] + margin))
 }
 
 /// Calls `f` for every integer point k with lo ≤ k < hi, x fastest.

@@ -129,3 +129,33 @@ fn a_particle_touching_a_face_keeps_no_velocity_into_it() {
         [3.0, -4.0]
     );
 }
+
+/// An obstacle whose faces pass through lattice points (x = 0.05 = container.min + 2.5 dx):
+/// no fluid particle starts on a face or closer than half a spacing to it, and none crosses it.
+/// Before, the particles on its faces were pushed back and counted as crossings (9 in 0.1 s).
+#[test]
+fn an_obstacle_with_faces_through_lattice_points_starts_and_stays_clear_of_fluid() {
+    let text = crate::common::water_block_scene(0.1).replace(
+        "[container]",
+        "[[obstacle]]\nmin = [0.05, 0.05]\nmax = [0.13, 0.11]\n\n[container]",
+    );
+    let scene = isph::scene::Scene::parse(&text, std::path::Path::new("obstacle.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let dir = crate::common::TempDir::new("obstacle-faces");
+    crate::common::run_scene(&scene, dir.path(), 0.1);
+    let kind: Vec<i32> = crate::common::read_frame(dir.path(), 0, "kind");
+    let pos: Vec<f64> = crate::common::read_frame(dir.path(), 0, "position");
+    let (lo, hi, half) = ([0.05, 0.05], [0.13, 0.11], 0.5 * 0.02 * (1.0 - 1e-9));
+    for i in (0..kind.len()).filter(|&i| kind[i] == 0) {
+        let x = [pos[3 * i], pos[3 * i + 1]];
+        let near = (0..2).all(|d| x[d] > lo[d] - half && x[d] < hi[d] + half);
+        assert!(
+            !near,
+            "fluid particle at {x:?} starts within half a spacing of the obstacle"
+        );
+    }
+    let crossings: f64 = crate::common::stats_column(dir.path(), "penetrations")
+        .iter()
+        .sum();
+    assert_eq!(crossings, 0.0);
+}
