@@ -182,6 +182,8 @@ impl<const D: usize> Simulation<D> {
     /// through a periodic boundary come back through the opposite one first.
     fn sort_by_cell(&mut self) -> Result<(), NumericalFailure> {
         let clock = Instant::now();
+        // (A no-op after a step; a checkpoint written before steps wrapped may hold positions
+        // past the period.)
         self.grid.wrap(&mut self.particles.pos);
         if let Err(out) = self.grid.sort(
             &self.particles.pos,
@@ -238,6 +240,9 @@ impl<const D: usize> Simulation<D> {
             self.time + dt
         };
         let penetrations = self.keep_off_the_faces();
+        // Along a periodic axis a particle leaves the period only in the advection: wrapped
+        // back here, the frames and checkpoints hold every position inside the box.
+        self.grid.wrap(&mut self.particles.pos);
         self.finish_step(dt, report, penetrations)
     }
 
