@@ -123,3 +123,19 @@ fn hydrostatic_errors_of_an_exact_and_a_shifted_column() {
     assert!((c.bottom_error(&high, 0.05).unwrap() - 0.01).abs() < 1e-12);
     assert!(c.rms_error(&[(0.95, 0.0)]).is_none());
 }
+
+/// `measure` refuses a run made from another scene (it measured one against the other and
+/// reported a meaningless error) and accepts the run's own scene with another end time.
+#[test]
+fn a_run_is_measured_only_against_its_own_scene() {
+    let dir = crate::common::TempDir::new("measure-own-scene");
+    let scene = crate::common::shipped_scene("hydrostatic_2d.toml");
+    crate::common::run_scene(&scene, dir.path(), 0.02);
+    let mut longer = scene.clone();
+    longer.end_time *= 2.0;
+    assert!(isph::validation::measure(Case::Hydrostatic, &longer, dir.path()).is_ok());
+    let mut other = scene.clone();
+    other.solver.alpha = 0.2;
+    let e = isph::validation::measure(Case::Hydrostatic, &other, dir.path()).unwrap_err();
+    assert!(e.to_string().contains("another scene"), "{e}");
+}

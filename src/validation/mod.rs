@@ -120,11 +120,34 @@ pub enum ValidationError {
 
 /// The error of the finished run of `scene` in `run_dir` against `case`.
 pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
+    made_from(case, scene, run_dir)?;
     match case {
         Case::Hydrostatic => hydrostatic::measure(scene, run_dir),
         Case::DamBreakFront => dam_break::measure(scene, run_dir),
         Case::Poiseuille => poiseuille::measure(scene, run_dir),
         Case::TaylorGreen => taylor_green::measure(scene, run_dir),
+    }
+}
+
+/// Refuses a run whose newest checkpoint (a run always ends with one) was written for another
+/// scene: the same scene hash as `isph resume` checks (name, end time and checkpoint settings
+/// may differ). A directory without a readable checkpoint is measured as it is.
+fn made_from(case: Case, scene: &Scene, run_dir: &Path) -> Result<(), ValidationError> {
+    let folder = crate::io::checkpoint_folder::folder(run_dir);
+    let Ok(newest) = crate::io::checkpoint_folder::newest_valid(&folder) else {
+        return Ok(());
+    };
+    match newest.valid {
+        Some(c) if c.state.scene_hash != scene.content_hash() => Err(ValidationError::Run {
+            case,
+            dir: run_dir.to_owned(),
+            message: format!(
+                "was made from another scene than {} (its checkpoint {} holds a different scene hash): measure it with the scene it was run from",
+                scene.path.display(),
+                c.path().display()
+            ),
+        }),
+        _ => Ok(()),
     }
 }
 
