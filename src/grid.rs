@@ -159,49 +159,6 @@ impl<const D: usize> CellList<D> {
         lin
     }
 
-    /// The cell of sorted particle k.
-    #[inline]
-    pub fn cell_of_sorted(&self, k: usize) -> usize {
-        self.sorted_cell[k] as usize
-    }
-
-    /// Whether cell c holds a particle of `kind` (after `sort`).
-    #[inline]
-    pub fn holds(&self, kind: Kind, c: usize) -> bool {
-        let base = kind as usize * self.cell_count() + c;
-        self.cell_start[base] < self.cell_start[base + 1]
-    }
-
-    /// Calls `f` with each cell that touches cell c (shares a face, an edge or a corner with
-    /// it), across a periodic boundary too.
-    pub fn for_each_touching_cell(&self, c: usize, mut f: impl FnMut(usize)) {
-        let mut k = [0i64; D];
-        let mut rest = c;
-        for d in 0..D {
-            k[d] = (rest % self.dims[d]) as i64;
-            rest /= self.dims[d];
-        }
-        for offset in 0..3usize.pow(D as u32) {
-            let (mut lin, mut stride, mut o, mut inside, mut zero) = (0, 1, offset, true, true);
-            for d in 0..D {
-                let step = (o % 3) as i64 - 1;
-                o /= 3;
-                zero &= step == 0;
-                let n = self.dims[d] as i64;
-                let mut j = k[d] + step;
-                if self.period[d].is_some() {
-                    j = j.rem_euclid(n);
-                }
-                inside &= (0..n).contains(&j);
-                lin += j.max(0) as usize * stride;
-                stride *= self.dims[d];
-            }
-            if inside && !zero {
-                f(lin);
-            }
-        }
-    }
-
     /// The block along axis d of coordinate x (of a point inside the grid), as
     /// `block_of_sorted` counts them.
     #[inline]

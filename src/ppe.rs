@@ -15,9 +15,7 @@
 //! first in the sorted order).
 
 use crate::free_surface::Support;
-use crate::grid::CellList;
 use crate::linsolve::LinearOperator;
-use crate::memory::ArraySize;
 use crate::multigrid::{stencil_slot, Aggregated};
 use crate::neighbours::{Lanes, LANES};
 use crate::particles::{Kind, Particles};
@@ -100,91 +98,23 @@ pub fn role<const D: usize>(
     }
 }
 
-/// Scratch of `pin_references`, per cell of the grid: a union-find forest of the bodies of
-/// fluid, and what each body holds.
-#[derive(Default)]
-pub struct Bodies {
-    parent: Vec<u32>,
-    top: Vec<u32>,
-}
-
-impl Bodies {
-    pub fn arrays(&self) -> [ArraySize; 2] {
-        [
-            ArraySize::sparse("body of cell", &self.parent),
-            ArraySize::sparse("top of body", &self.top),
-        ]
-    }
-}
-
-/// `Bodies::top` of a body with no fluid particle yet.
-const NO_PARTICLE: u32 = u32::MAX;
-/// `Bodies::top` of a body with a free-surface particle.
-const ANCHORED: u32 = u32::MAX - 1;
-
-/// The root of cell c's tree, halving the path on the way.
-fn body_root(parent: &mut [u32], mut c: u32) -> u32 {
-    while parent[c as usize] != c {
-        let up = parent[parent[c as usize] as usize];
-        parent[c as usize] = up;
-        c = up;
-    }
-    c
-}
-
-/// The PPE of a body of fluid without a free-surface particle is singular: the level of its
-/// pressure is in no equation. Each such body (a box full of liquid, a pocket of water shut in
-/// by obstacles) gets its highest interior particle (the first in index order among equals)
-/// pinned to P = 0 as a reference. A body is a connected set of touching cells that hold fluid:
-/// cells are a quarter or half of the support wide, so a wall at least a cell thick keeps two
-/// bodies apart. Returns the highest reference when no particle at all is free (the fluid fills
-/// its container: its pressure is then shifted to a zero mean, `step`), None otherwise.
-pub fn pin_references<const D: usize>(
-    grid: &CellList<D>,
+/// If the fluid has no free surface at all (a full closed or periodic box) the PPE is singular;
+/// the highest fluid particle (the first in index order among equals) is then the reference,
+/// pinned to P = 0. Returns it (None: the fluid has a free surface, and no reference).
+pub fn pin_reference<const D: usize>(
     p: &Particles<D>,
     gravity: [f64; D],
     roles: &mut [Role],
-    bodies: &mut Bodies,
 ) -> Option<usize> {
-    let n = grid.cell_count();
-    let Bodies { parent, top } = bodies;
-    parent.clear();
-    parent.extend(0..n as u32);
-    for c in (0..n).filter(|&c| grid.holds(Kind::Fluid, c)) {
-        grid.for_each_touching_cell(c, |other| {
-            if other > c && grid.holds(Kind::Fluid, other) {
-                let (a, b) = (body_root(parent, c as u32), body_root(parent, other as u32));
-                parent[a.max(b) as usize] = a.min(b);
-            }
-        });
+    if roles.iter().any(|r| r.is_free()) {
+        return None;
     }
     let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
-    top.clear();
-    top.resize(n, NO_PARTICLE);
-    for (i, &role) in roles.iter().enumerate() {
-        let body = body_root(parent, grid.cell_of_sorted(i) as u32) as usize;
-        match (role, top[body]) {
-            (_, ANCHORED) => {}
-            (Role::Surface | Role::Splash, _) => top[body] = ANCHORED,
-            (Role::Interior, NO_PARTICLE) => top[body] = i as u32,
-            (Role::Interior, t) if height(i) > height(t as usize) => top[body] = i as u32,
-            _ => {}
-        }
-    }
-    let confined = !roles.iter().any(|r| r.is_free());
-    let mut highest: Option<usize> = None;
-    for c in 0..n {
-        if parent[c] as usize != c || top[c] == NO_PARTICLE || top[c] == ANCHORED {
-            continue;
-        }
-        let pin = top[c] as usize;
-        roles[pin] = Role::Reference;
-        if highest.is_none_or(|h| height(pin) > height(h) || (height(pin) == height(h) && pin < h))
-        {
-            highest = Some(pin);
-        }
-    }
-    highest.filter(|_| confined)
+    let top = (0..roles.len())
+        .filter(|&i| roles[i] == Role::Interior)
+        .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)))?;
+    roles[top] = Role::Reference;
+    Some(top)
 }
 
 /// Marks fluid particles whose kernel support holds no free-surface particle: there the

@@ -92,11 +92,9 @@ pub struct Workspace<const D: usize> {
     /// tangential direction (with shifting).
     surface_normal: Vec<[f64; D]>,
     roles: Vec<Role>,
-    /// The particle pinned to P = 0 where the fluid has no free surface (`ppe::pin_references`;
+    /// The particle pinned to P = 0 where the fluid has no free surface (`ppe::pin_reference`;
     /// None: the fluid has one, its pressure is absolute and cannot hold a tension).
     reference: Option<usize>,
-    /// The bodies of fluid, found each step to pin those without a free surface.
-    bodies: ppe::Bodies,
     /// No free-surface particle in the kernel support.
     full_support: Vec<bool>,
     /// Kernel gradient correction L_i of each particle, Eq. (25) (with the kernel correction).
@@ -131,7 +129,6 @@ impl<const D: usize> Default for Workspace<D> {
             surface_normal: Vec::new(),
             roles: Vec::new(),
             reference: None,
-            bodies: ppe::Bodies::default(),
             full_support: Vec::new(),
             corrections: Vec::new(),
             correction_slot: Vec::new(),
@@ -245,7 +242,6 @@ impl<const D: usize> Workspace<D> {
             surface_normal,
             roles,
             reference: _,
-            bodies,
             full_support,
             corrections,
             correction_slot,
@@ -304,7 +300,6 @@ impl<const D: usize> Workspace<D> {
             ),
             (Stage::Shifting, ArraySize::of_components("δr", shift)),
         ];
-        arrays.extend(bodies.arrays().map(|a| (Stage::FreeSurface, a)));
         let solver = bicgstab.arrays().into_iter().chain(multigrid.fine_arrays());
         arrays.extend(solver.map(|a| (Stage::PressureSolve, a)));
         // Every array of the workspace holds the fluid particles only (see the module doc).
@@ -366,8 +361,7 @@ impl<const D: usize> Workspace<D> {
                     *lp = l_pressure;
                 }
             });
-        self.reference =
-            ppe::pin_references(nb.grid(), p, set.gravity, &mut self.roles, &mut self.bodies);
+        self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
         ppe::full_support(nb, &self.roles, &mut self.full_support);
     }
 
