@@ -249,7 +249,7 @@ impl<'a, const D: usize> Driver<'a, D> {
         let interval = self.scene.output_interval;
         let scheduled = self.next_output as f64 * interval;
         let rounding = FRAME_TIME_ROUNDING * interval;
-        if scheduled < self.end - rounding {
+        if scheduled <= self.sim.time || scheduled < self.end - rounding {
             (scheduled, true)
         } else {
             (self.end, scheduled <= self.end + rounding)

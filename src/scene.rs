@@ -292,12 +292,12 @@ const MAX_FRAMES: f64 = 1e5;
 /// on the 3D dam break from 10⁴ to 10⁶ particles (docs/performance.md).
 const PEAK_BYTES_PER_PARTICLE: f64 = 600.0;
 
-/// MemAvailable of /proc/meminfo [bytes] (None where it cannot be read).
-fn available_memory() -> Option<f64> {
+/// MemTotal of /proc/meminfo [bytes] (None where it cannot be read).
+fn machine_memory() -> Option<f64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let kib: f64 = info
         .lines()
-        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .find_map(|l| l.strip_prefix("MemTotal:"))?
         .trim()
         .strip_suffix("kB")?
         .trim()
@@ -647,8 +647,9 @@ impl Validator<'_> {
     }
 
     /// Refuses a scene whose particles could not be held: more than the u32 indices of the
-    /// cell sort reach, or more memory than the machine has available at the peak of a run
-    /// (`PEAK_BYTES_PER_PARTICLE`).
+    /// cell sort reach, or more memory at the peak of a run (`PEAK_BYTES_PER_PARTICLE`) than
+    /// the machine has in all (not what is free now: a study measures its finished points while
+    /// others run).
     fn fits_in_memory(&self, scene: &Scene) -> Result<(), SceneError> {
         let particles = crate::lattice::particle_bound(scene);
         let key = "simulation.spacing";
@@ -662,15 +663,15 @@ impl Validator<'_> {
             format!("{what}, more than the {} isph can index", u32::MAX),
         )?;
         let needed = particles * PEAK_BYTES_PER_PARTICLE;
-        if let Some(available) = available_memory() {
+        if let Some(memory) = machine_memory() {
             const GIB: f64 = (1u64 << 30) as f64;
             self.check(
-                needed <= available,
+                needed <= memory,
                 key,
                 format!(
-                    "{what}: about {:.1} GiB at {PEAK_BYTES_PER_PARTICLE} B/particle, more than the {:.1} GiB of memory available here",
+                    "{what}: about {:.1} GiB at {PEAK_BYTES_PER_PARTICLE} B/particle, more than the {:.1} GiB of memory this machine has",
                     needed / GIB,
-                    available / GIB
+                    memory / GIB
                 ),
             )?;
         }

@@ -70,7 +70,7 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
         (
             "max = [0.4, 0.3]",
             "max = [1e6, 0.3]",
-            &["simulation.spacing", "GiB of memory available"],
+            &["simulation.spacing", "GiB of memory this machine has"],
         ),
         (
             "dimensions = 2",
