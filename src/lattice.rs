@@ -4,7 +4,7 @@
 use crate::faces::Faces;
 use crate::kernel::SUPPORT_IN_H;
 use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
-use crate::scene::Scene;
+use crate::scene::{Aabb, Scene};
 
 /// Number of dummy wall layers that fill the kernel support 3h.
 pub fn wall_layers(scene: &Scene) -> usize {
@@ -15,19 +15,16 @@ pub fn wall_layers(scene: &Scene) -> usize {
 /// (blocks and obstacles as if none overlapped another): a scene too large for the machine is
 /// refused before its particles fill the memory.
 pub fn particle_bound(scene: &Scene) -> f64 {
-    let dx = scene.spacing;
-    let points = |b: &crate::scene::Aabb| -> f64 {
-        (0..scene.dimensions)
-            .map(|d| ((b.max[d] - b.min[d]) / dx).ceil() + 1.0)
-            .product()
+    // Lattice points along axis d of box b, at most; with `grow` more on each side.
+    let along = |b: &Aabb, d: usize, grow: f64| {
+        ((b.max[d] - b.min[d]) / scene.spacing).ceil() + 1.0 + 2.0 * grow
     };
+    let points = |b: &Aabb| -> f64 { (0..scene.dimensions).map(|d| along(b, d, 0.0)).product() };
     let layers = wall_layers(scene) as f64;
-    let inside = points(&scene.container);
+    let c = &scene.container;
+    let inside = points(c);
     let with_walls: f64 = (0..scene.dimensions)
-        .map(|d| {
-            let cells = ((scene.container.max[d] - scene.container.min[d]) / dx).ceil() + 1.0;
-            cells + if scene.periodic[d] { 0.0 } else { 2.0 * layers }
-        })
+        .map(|d| along(c, d, if scene.periodic[d] { 0.0 } else { layers }))
         .product();
     let fluid: f64 = scene.blocks.iter().map(|b| points(&b.region)).sum();
     let obstacles: f64 = scene.obstacles.iter().map(points).sum();
@@ -135,10 +132,7 @@ fn in_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
 /// in the first step.
 fn near_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
     let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
-    scene
-        .obstacles
-        .iter()
-        .any(|o| (0..D).all(|d| x[d] > o.min[d] - margin && x[d] < o.max[d] + margin))
+    scene.obstacles.iter().any(|o| o.contains_within(x, margin))
 }
 
 /// Calls `f` for every integer point k with lo ≤ k < hi, x fastest.

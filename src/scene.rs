@@ -267,10 +267,15 @@ pub struct Aabb {
 impl Aabb {
     /// True when x lies strictly inside the box.
     pub fn contains(&self, x: &[f64]) -> bool {
+        self.contains_within(x, 0.0)
+    }
+
+    /// True when x lies strictly inside the box grown by `margin` on every side.
+    pub fn contains_within(&self, x: &[f64], margin: f64) -> bool {
         x.iter()
             .zip(&self.min)
             .zip(&self.max)
-            .all(|((x, lo), hi)| x > lo && x < hi)
+            .all(|((x, lo), hi)| *x > lo - margin && *x < hi + margin)
     }
 
     fn within(&self, outer: &Aabb) -> bool {
