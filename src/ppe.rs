@@ -187,39 +187,46 @@ pub fn source<const D: usize>(
     fill(b, |i| match op.roles[i] {
         Role::Interior => {
             divergence_source(nb, p, corrections.of(i), u_star, full[i], dt, alpha, i)
-                + op.wall_source(i)
         }
         Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
         Role::Splash | Role::Reference => 0.0,
     });
-    if closed {
-        remove_net_compression(op, b);
-    }
+    let net = if closed {
+        net_compression(op.roles, b)
+    } else {
+        0.0
+    };
+    // The walls' known differences (the Neumann ghosts) complete the interior rows.
+    b.par_iter_mut()
+        .zip(op.roles)
+        .enumerate()
+        .for_each(|(i, (b, &role))| {
+            if role == Role::Interior {
+                *b = *b - net + op.wall_source(i);
+            }
+        });
 }
 
 /// In a closed box the interior rows' compression must sum to zero: the volume cannot change,
 /// and a net source would have nowhere to go but the reference particle's row (a spurious
 /// point source of pressure there). The SPH divergence and the density term leave a small net
-/// sum (from the disorder of the particles); it is removed evenly from every interior row.
-/// The walls' known differences are not compression and stay out of it: under gravity they
-/// are what holds the hydrostatic pressure up, and taking their net sum out as well drove a
-/// flow towards the reference (0.35 m/s after 0.5 s in a 0.5 × 0.4 m box full of water).
-fn remove_net_compression<const D: usize>(op: &PressureOperator<D>, b: &mut [f64]) {
-    let roles = op.roles;
-    let [count, sum, walls] = crate::reduce::sums(b.len(), |i| {
+/// sum (from the disorder of the particles); its mean over the interior rows `b` (their
+/// compression only), which `source` removes from each. The walls' known differences are not
+/// compression and stay out of it: under gravity they are what holds the hydrostatic pressure
+/// up, and taking their net sum out as well drove a flow towards the reference (0.35 m/s after
+/// 0.5 s in a 0.5 × 0.4 m box full of water).
+fn net_compression(roles: &[Role], b: &[f64]) -> f64 {
+    let [count, sum] = crate::reduce::sums(b.len(), |i| {
         if roles[i] == Role::Interior {
-            [1.0, b[i], op.wall_source(i)]
+            [1.0, b[i]]
         } else {
-            [0.0; 3]
+            [0.0; 2]
         }
     });
     if count > 0.0 {
-        let mean = (sum - walls) / count;
-        b.par_iter_mut().zip(roles).for_each(|(b, &role)| {
-            if role == Role::Interior {
-                *b -= mean;
-            }
-        });
+        sum / count
+    } else {
+        0.0
     }
 }
 
