@@ -20,7 +20,9 @@ use crate::multigrid::{stencil_slot, Aggregated};
 use crate::neighbours::{Lanes, LANES};
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
-use crate::sph::{interface_weight, velocity_gradient, Correction, Corrections, Neighbours};
+use crate::sph::{
+    interface_weight, mass_at_density, velocity_gradient, Correction, Corrections, Neighbours,
+};
 use crate::wall::{behind_walls, ghost_pressure_difference, ghost_velocity};
 use rayon::prelude::*;
 use wide::f64x4;
@@ -284,14 +286,13 @@ fn laplacian_mass<const D: usize>(
     rest_density: f64x4,
     l: &Lanes<D>,
 ) -> f64x4 {
-    let mass = l.load(&p.mass);
     if !interfaces {
-        return mass;
+        return l.load(&p.mass);
     }
-    let (rho_i, rho_j) = (rest_density, l.load(&p.rest_density));
+    let mass = mass_at_density(p, rest_density, l);
     match l.kind {
-        Kind::Fluid => mass * (interface_weight(rho_i, rho_j) * (rho_i / rho_j)),
-        Kind::Wall => mass * (rho_i / rho_j),
+        Kind::Fluid => mass * interface_weight(rest_density, l.load(&p.rest_density)),
+        Kind::Wall => mass,
     }
 }
 

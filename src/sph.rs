@@ -15,10 +15,20 @@ pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -
     let mut rho = f64x4::ZERO;
     let rho0_i = f64x4::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |l| {
-        let mass = l.load(&p.mass) * (rho0_i / l.load(&p.rest_density));
-        rho = ((mass * nb.kernel.w4(l.r)) & l.mask) + rho;
+        rho = ((mass_at_density(p, rho0_i, l) * nb.kernel.w4(l.r)) & l.mask) + rho;
     });
     p.mass[i] * nb.kernel.w(0.0) + rho.reduce_add()
+}
+
+/// m_j ρ0_i/ρ0_j = ρ0_i V_j of the lanes: the mass of neighbour j's volume at particle i's rest
+/// density, exactly m_j where the two share one (a wall takes the first fluid's).
+#[inline(always)]
+pub fn mass_at_density<const D: usize>(
+    p: &Particles<D>,
+    rest_density_i: f64x4,
+    l: &Lanes<D>,
+) -> f64x4 {
+    l.load(&p.mass) * (rest_density_i / l.load(&p.rest_density))
 }
 
 /// 2ρ0_i/(ρ0_i + ρ0_j): across a pair of fluids, the harmonic mean 2/(ρ0_i + ρ0_j) of 1/ρ
