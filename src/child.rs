@@ -44,18 +44,8 @@ impl RunReport {
 
 /// The peak resident set size of this process so far (VmHWM).
 pub fn peak_resident_bytes() -> Result<u64, ChildError> {
-    let status = std::fs::read_to_string("/proc/self/status").map_err(|e| ChildError::Memory {
-        message: e.to_string(),
-    })?;
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().strip_suffix("kB"))
-        .and_then(|v| v.trim().parse::<u64>().ok())
-        .map(|kib| kib * 1024)
-        .ok_or_else(|| ChildError::Memory {
-            message: "no `VmHWM: … kB` line".into(),
-        })
+    crate::memory::proc_bytes("/proc/self/status", "VmHWM")
+        .map_err(|message| ChildError::Memory { message })
 }
 
 /// Runs `command` to its end and reads the TOML report it prints on stdout. A child that

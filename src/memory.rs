@@ -71,3 +71,15 @@ impl ArraySize {
         }
     }
 }
+
+/// The `field: n kB` line of a /proc file (`/proc/self/status`, `/proc/meminfo`) in bytes; the
+/// error says why it could not be read.
+pub fn proc_bytes(path: &str, field: &str) -> Result<u64, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    text.lines()
+        .find_map(|l| l.strip_prefix(field)?.strip_prefix(':'))
+        .and_then(|v| v.trim().strip_suffix("kB"))
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .map(|kib| kib * 1024)
+        .ok_or_else(|| format!("no `{field}: … kB` line"))
+}

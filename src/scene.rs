@@ -297,20 +297,6 @@ const MAX_FRAMES: f64 = 1e5;
 /// on the 3D dam break from 10⁴ to 10⁶ particles (docs/performance.md).
 const PEAK_BYTES_PER_PARTICLE: f64 = 600.0;
 
-/// MemTotal of /proc/meminfo [bytes] (None where it cannot be read).
-fn machine_memory() -> Option<f64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let kib: f64 = info
-        .lines()
-        .find_map(|l| l.strip_prefix("MemTotal:"))?
-        .trim()
-        .strip_suffix("kB")?
-        .trim()
-        .parse()
-        .ok()?;
-    Some(kib * 1024.0)
-}
-
 /// A validated scene.
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -668,7 +654,9 @@ impl Validator<'_> {
             format!("{what}, more than the {} isph can index", u32::MAX),
         )?;
         let needed = particles * PEAK_BYTES_PER_PARTICLE;
-        if let Some(memory) = machine_memory() {
+        // The machine's memory in all (MemTotal); no check where /proc/meminfo cannot be read.
+        if let Ok(memory) = crate::memory::proc_bytes("/proc/meminfo", "MemTotal") {
+            let memory = memory as f64;
             const GIB: f64 = (1u64 << 30) as f64;
             self.check(
                 needed <= memory,
