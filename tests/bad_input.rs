@@ -248,8 +248,7 @@ fn a_block_one_spacing_wide_is_accepted() {
             "min = [0.28, 0.1]\nmax = [0.3, 0.12]",
         )
         .replace("spacing = 0.02", "spacing = 0.02\nname = \"one\"");
-    let scene =
-        isph::scene::Scene::parse(&text, Path::new("one.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let scene = crate::common::scene_from_text(&text);
     let plan = isph::plan::Plan::new(&scene).unwrap_or_else(|e| panic!("{e}"));
     assert!(plan.to_string().contains("particles: 1 fluid"), "{plan}");
 }

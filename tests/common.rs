@@ -135,6 +135,11 @@ max = [0.4, 0.3]
     )
 }
 
+/// A scene from TOML text (errors name the file `scene.toml`).
+pub fn scene_from_text(text: &str) -> Scene {
+    Scene::parse(text, Path::new("scene.toml")).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Loads a scene shipped in `scenes/`.
 pub fn shipped_scene(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -3,16 +3,15 @@
 //! 0.32999999999999996 against 0.33), so that no step is cut to a sliver (a step of 5e-17 s
 //! blew the flow up: max speed 4e12 m/s, and the end checkpoint held that state).
 
-use crate::common::{run_scene, stats_column, water_block_scene, TempDir};
+use crate::common::{run_scene, scene_from_text, stats_column, water_block_scene, TempDir};
 use isph::scene::Scene;
-use std::path::Path;
 
 fn scene(end_time: f64, interval: f64) -> Scene {
     let text = water_block_scene(end_time).replace(
         "output_interval = 0.02",
         &format!("output_interval = {interval}"),
     );
-    Scene::parse(&text, Path::new("frames.toml")).unwrap_or_else(|e| panic!("{e}"))
+    scene_from_text(&text)
 }
 
 /// Runs to `until`, checks the frame times against `expected` and that no step was shorter

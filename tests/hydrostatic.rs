@@ -2,6 +2,7 @@
 
 use crate::common::{read_frame, run_scene, shipped_scene, stats_column, TempDir};
 use isph::validation::{measure, Case};
+use std::path::Path;
 
 #[test]
 fn still_water_has_hydrostatic_pressure_and_no_penetration() {
@@ -34,8 +35,7 @@ fn a_closed_box_full_of_water_stays_at_rest() {
     let text = crate::common::water_block_scene(0.5)
         .replace("max = [0.2, 0.2]", "max = [0.4, 0.3]")
         .replace("output_interval = 0.02", "output_interval = 0.1");
-    let scene = isph::scene::Scene::parse(&text, std::path::Path::new("full_box.toml"))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let scene = crate::common::scene_from_text(&text);
     let dir = TempDir::new("closed_box");
     let summary = run_scene(&scene, dir.path(), 0.5);
     // Measured: 2.4e-7 m/s at most (√(gH) = 1.7 m/s).
@@ -44,15 +44,7 @@ fn a_closed_box_full_of_water_stays_at_rest() {
         .fold(0.0, f64::max);
     assert!(fastest < 1e-4, "max speed {fastest} m/s");
     // The pressure against depth: a least-squares line through the last frame's fluid.
-    let last = summary.frames.len() - 1;
-    let kind: Vec<i32> = read_frame(dir.path(), last, "kind");
-    let pos: Vec<f64> = read_frame(dir.path(), last, "position");
-    let pressure: Vec<f64> = read_frame(dir.path(), last, "pressure");
-    let fluid: Vec<(f64, f64)> = (0..kind.len())
-        .filter(|&i| kind[i] == 0)
-        .map(|i| (pos[3 * i + 1], pressure[i]))
-        .collect();
-    let gradient = pressure_gradient(&fluid);
+    let gradient = pressure_gradient(dir.path(), summary.frames.len() - 1, |_, _| true);
     // Measured: −ρ g to 2e-8.
     assert!(
         (gradient / (-1000.0 * 9.81) - 1.0).abs() < 1e-3,
@@ -60,8 +52,17 @@ fn a_closed_box_full_of_water_stays_at_rest() {
     );
 }
 
-/// The least-squares slope dP/dy through the (y, P) points.
-fn pressure_gradient(points: &[(f64, f64)]) -> f64 {
+/// dP/dy in frame `frame` of the run in `dir`: the least-squares slope of the pressure against
+/// y over the fluid particles that `keep(fluid index, x)` selects.
+fn pressure_gradient(dir: &Path, frame: usize, keep: impl Fn(i32, f64) -> bool) -> f64 {
+    let kind: Vec<i32> = read_frame(dir, frame, "kind");
+    let fluid: Vec<i32> = read_frame(dir, frame, "fluid");
+    let pos: Vec<f64> = read_frame(dir, frame, "position");
+    let pressure: Vec<f64> = read_frame(dir, frame, "pressure");
+    let points: Vec<(f64, f64)> = (0..kind.len())
+        .filter(|&i| kind[i] == 0 && keep(fluid[i], pos[3 * i]))
+        .map(|i| (pos[3 * i + 1], pressure[i]))
+        .collect();
     let n = points.len() as f64;
     let (my, mp) = points
         .iter()
@@ -109,8 +110,7 @@ max = [0.5, 0.2]
 min = [0.0, 0.0]
 max = [0.5, 0.4]
 "#;
-    let scene = isph::scene::Scene::parse(text, std::path::Path::new("layers.toml"))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let scene = crate::common::scene_from_text(text);
     let dir = TempDir::new("layers");
     let summary = run_scene(&scene, dir.path(), 0.6);
     // Measured: 0.021 m/s at most, after the first step (√(gH) = 1.4 m/s): the particles
@@ -120,19 +120,13 @@ max = [0.5, 0.4]
         .fold(0.0, f64::max);
     assert!(fastest < 0.05, "max speed {fastest} m/s");
     let last = summary.frames.len() - 1;
-    let kind: Vec<i32> = read_frame(dir.path(), last, "kind");
-    let fluid: Vec<u16> = read_frame(dir.path(), last, "fluid");
-    let pos: Vec<f64> = read_frame(dir.path(), last, "position");
-    let pressure: Vec<f64> = read_frame(dir.path(), last, "pressure");
     // Each layer's gradient, away from the side walls: measured 0.3% (water) and 4.3% (oil)
     // above ρ0 g at 0.6 s. The oil's drifts on, slowly (6% at 2 s, max speed 0.04 m/s): the
     // weighted differences are exact only for pairs the interface halves.
     for (index, rest_density) in [(0, 1000.0), (1, 800.0)] {
-        let points: Vec<(f64, f64)> = (0..kind.len())
-            .filter(|&i| kind[i] == 0 && fluid[i] == index && (pos[3 * i] - 0.25).abs() < 0.2)
-            .map(|i| (pos[3 * i + 1], pressure[i]))
-            .collect();
-        let gradient = pressure_gradient(&points);
+        let gradient = pressure_gradient(dir.path(), last, |fluid, x| {
+            fluid == index && (x - 0.25).abs() < 0.2
+        });
         let expected = -rest_density * 9.81;
         assert!(
             (gradient / expected - 1.0).abs() < 0.08,

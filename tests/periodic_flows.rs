@@ -79,8 +79,7 @@ fn frames_hold_periodic_positions_inside_the_box() {
         "max = [0.4, 0.3]",
         "max = [0.4, 0.3]\nperiodic = [true, false]",
     );
-    let scene = isph::scene::Scene::parse(&text, std::path::Path::new("periodic.toml"))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let scene = crate::common::scene_from_text(&text);
     let dir = TempDir::new("periodic-positions");
     let summary = run_scene(&scene, dir.path(), 0.3);
     let (lo, hi) = (scene.container.min[0], scene.container.max[0]);

@@ -3,15 +3,11 @@
 //! viscous time-step limit, large CFL numbers, a 3D dam break over an obstacle, and particle
 //! disorder with and without shifting.
 
-use crate::common::{read_frame, run_scene, stats_column, TempDir};
+use crate::common::{read_frame, run_scene, scene_from_text as scene, stats_column, TempDir};
 use isph::scene::Scene;
 use std::path::Path;
 
 const G: f64 = 9.81;
-
-fn scene(text: &str) -> Scene {
-    Scene::parse(text, Path::new("stability.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// A 2D dam break: a column `width` × 2 `width` of water at the left of a tank 4 `width` long,
 /// so that the surge hits the far wall, runs up it and overturns. `extra` is appended.

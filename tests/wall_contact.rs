@@ -139,8 +139,7 @@ fn an_obstacle_with_faces_through_lattice_points_starts_and_stays_clear_of_fluid
         "[container]",
         "[[obstacle]]\nmin = [0.05, 0.05]\nmax = [0.13, 0.11]\n\n[container]",
     );
-    let scene = isph::scene::Scene::parse(&text, std::path::Path::new("obstacle.toml"))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let scene = crate::common::scene_from_text(&text);
     let dir = crate::common::TempDir::new("obstacle-faces");
     crate::common::run_scene(&scene, dir.path(), 0.1);
     let kind: Vec<i32> = crate::common::read_frame(dir.path(), 0, "kind");
