@@ -19,6 +19,7 @@ fn frame(points: &[(f64, f64)]) -> Frame {
         velocity: vec![[0.0; 3]; n],
         pressure: vec![0.0; n],
         kind,
+        free_surface: vec![0; n],
     }
 }
 
@@ -54,6 +55,17 @@ fn front_and_column_height_ignore_walls_and_count_from_the_back_wall() {
     let f = frame(&[(-0.4, 3.0), (0.2, 4.5), (3.5, 1.1), (1.0, 1.5)]);
     assert_eq!(c.front(&f), 2.0);
     assert_eq!(c.height_at_wall(&f), 0.5);
+}
+
+#[test]
+fn the_front_is_the_water_body_not_spray_ahead_of_it() {
+    let c = column();
+    let mut f = frame(&[(3.5, 1.1), (1.0, 1.5), (7.5, 1.05)]);
+    // The particle at x = 7.5 slid off the tip: the solver flagged it as spray (code 2).
+    f.free_surface[2] = 2;
+    assert_eq!(c.front(&f), 2.0);
+    f.free_surface[2] = 1;
+    assert_eq!(c.front(&f), 4.0);
 }
 
 #[test]

@@ -208,6 +208,9 @@ pub struct Frame {
     pub pressure: Vec<f64>,
     /// 0 fluid, 1 wall (`particles::Kind` codes).
     pub kind: Vec<i32>,
+    /// The PPE role of each fluid particle: 0 interior, 1 free surface, 2 spray
+    /// (`ppe::Role::code`); 0 for walls.
+    pub free_surface: Vec<i32>,
 }
 
 /// Reads the frames of a finished (or running) run's particles.h5.
@@ -263,6 +266,7 @@ impl FrameReader {
                 velocity: triples("velocity")?,
                 pressure: g.dataset("pressure")?.read_raw()?,
                 kind: g.dataset("kind")?.read_raw()?,
+                free_surface: g.dataset("free_surface")?.read_raw()?,
             })
         };
         read().map_err(|e| self.error(e))

@@ -2,7 +2,12 @@
 //! container's min-x wall): the surge front against Martin & Moyce (1952), 2D or 3D.
 //!
 //! With a the width of the column (along x) and g = |gravity|, time is T = t √(2g/a) and the
-//! front Z = x/a, x the largest distance of a fluid particle from the back wall. The error is
+//! front Z = x/a, x the largest distance from the back wall of a fluid particle that is not
+//! spray (`Role::Splash`: too isolated to carry a pressure gradient). Once the surge has thinned
+//! to a layer a particle or two thick, single particles slide off its tip one behind the other,
+//! up to 18 spacings ahead of the water at a/20 (T = 9.2); the experiment's front is that of
+//! the water body, and counting the loose particles made the error jump between 6.6% and 9.1%
+//! with a change of the tank's length by 2 cm. The error is
 //! the mean relative error |Z − Z_ref| / Z_ref over the tabulated points whose time the run
 //! reached, each against the frame nearest its time; points whose front lies beyond 90% of the
 //! way to the far wall are left out (the wall stops the surge there). Details: the largest of
@@ -11,6 +16,7 @@
 
 use super::{fluid, no_frames, vertical, Case, Measured, ValidationError};
 use crate::io::frames::{Frame, FrameReader};
+use crate::ppe::Role;
 use crate::scene::Scene;
 use std::path::Path;
 
@@ -116,9 +122,10 @@ impl Column {
             .collect()
     }
 
-    /// Z: the largest distance of a fluid particle from the back wall, over a.
+    /// Z: the largest distance of a fluid particle that is not spray from the back wall, over a.
     pub fn front(&self, frame: &Frame) -> f64 {
         fluid(frame)
+            .filter(|&i| frame.free_surface[i] != i32::from(Role::Splash.code()))
             .map(|i| frame.position[i][0] - self.back)
             .fold(0.0, f64::max)
             / self.width
