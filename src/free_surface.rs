@@ -21,6 +21,12 @@
 //!    every umbrella but no fluid around it — and sparse fluid beside a wall, whose wall
 //!    particles fill the moment matrix. A Laplacian row there sees a few neighbours converging
 //!    at impact speed and answers with a pressure spike that blows the spray apart.
+//! 4. A particle whose summation density exceeds ρ0 is never free surface, whatever the other
+//!    rules say: a truncated support holds less mass than a full one, so one that holds more
+//!    is compressed, and a free-surface row (a fixed pressure) cannot push back. At the tip of
+//!    a surge on a no-slip floor (ν = 1e-3 m²/s, dx = 0.01 m) a particle was squeezed to
+//!    1.12 ρ0 between the floor and the water behind it; its row then answered with 4.9 kPa
+//!    and shot it out at 2.8 m/s, 35% faster than the front (2.1 m/s with this rule).
 
 use crate::sph::Neighbours;
 use crate::vector::{dot, norm};
@@ -76,6 +82,9 @@ impl<const D: usize> Support<D> {
     /// Whether fluid particle `i` with this support and summation density ρ_i = `density_ratio`
     /// ρ0 lies on the free surface.
     pub fn is_free_surface(&self, nb: &Neighbours<D>, i: usize, density_ratio: f64) -> bool {
+        if density_ratio > 1.0 {
+            return false;
+        }
         if self.is_splash() || density_ratio < SPRAY_DENSITY {
             return true;
         }

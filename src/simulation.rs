@@ -10,7 +10,7 @@ use crate::memory::ArraySize;
 use crate::particles::Particles;
 use crate::reduce;
 use crate::scene::{GhostPressure, Scene};
-use crate::step::{speed, StepReport, StepSettings, Workspace};
+use crate::step::{speed, StepLength, StepReport, StepSettings, Workspace};
 use crate::timings::{Stage, Timings};
 use std::time::Instant;
 
@@ -229,7 +229,7 @@ impl<const D: usize> Simulation<D> {
                 self.kernel,
                 &self.settings,
                 &self.faces,
-                dt,
+                StepLength { dt, limit },
                 lands_on_target,
                 &mut self.timings,
             )

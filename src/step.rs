@@ -74,6 +74,17 @@ pub fn stages(effects: &Effects) -> Vec<Stage> {
         .collect()
 }
 
+/// The length of a step and the limit it was cut from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepLength {
+    /// Δt of this step [s].
+    pub dt: f64,
+    /// Δt_max, the limit of the CFL, viscous and body-force conditions [s]: Δt is shorter
+    /// only where the step is cut to land on a frame time. The density-invariance term of the
+    /// PPE relaxes the density error over Δt_max, not Δt (`ppe::source`).
+    pub limit: f64,
+}
+
 /// What a step measured.
 #[derive(Clone, Copy, Debug)]
 pub struct StepReport {
@@ -149,7 +160,7 @@ impl<const D: usize> Default for Workspace<D> {
 }
 
 impl<const D: usize> Workspace<D> {
-    /// Advances the particles (sorted by cell in `grid`) by one step of `dt`, running the
+    /// Advances the particles (sorted by cell in `grid`) by one step of `step.dt`, running the
     /// stages of `stages(&set.effects)` between the cell sort and the diagnostics. The wall
     /// particles' pressure, which only the frames hold, is computed when `ends_on_frame`: in a
     /// large tank with a small block of water most wall particles are dry, and visiting them
@@ -162,11 +173,11 @@ impl<const D: usize> Workspace<D> {
         kernel: Quintic<D>,
         set: &StepSettings<D>,
         faces: &Faces,
-        dt: f64,
+        step: StepLength,
         ends_on_frame: bool,
         timings: &mut Timings,
     ) -> Result<StepReport, SolverError> {
-        let effects = &set.effects;
+        let (effects, dt) = (&set.effects, step.dt);
         let fluid = grid.range_of(Kind::Fluid);
         debug_assert_eq!(fluid.start, 0, "the fluid comes first in the sorted order");
         let nf = fluid.end;
@@ -198,7 +209,7 @@ impl<const D: usize> Workspace<D> {
             }
             self.predict(&nb, p, set, dt);
             lap(Stage::Predictor);
-            let solve = self.solve_pressure(&nb, p, set, dt)?;
+            let solve = self.solve_pressure(&nb, p, set, step)?;
             let (clip, pressure) = (self.reference.is_none(), &self.pressure);
             fill(&mut p.pressure[..nf], |i| cavitation(clip, pressure[i]));
             lap(Stage::PressureSolve);
@@ -444,7 +455,7 @@ impl<const D: usize> Workspace<D> {
         nb: &Neighbours<D>,
         p: &Particles<D>,
         set: &StepSettings<D>,
-        dt: f64,
+        step: StepLength,
     ) -> Result<SolveInfo, SolverError> {
         let n = self.roles.len();
         for a in &mut self.row_vectors {
@@ -478,8 +489,8 @@ impl<const D: usize> Workspace<D> {
             set.spacing,
             Corrections::sparse(kernel_correction, &self.correction_slot, &self.corrections),
             &self.u_star,
-            dt,
-            set.alpha,
+            step.dt,
+            set.alpha / step.limit,
             &mut self.rhs,
         );
         let roles = &self.roles;

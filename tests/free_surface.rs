@@ -99,3 +99,27 @@ fn sheets_and_a_lone_particle_are_surface() {
     let lone = Lattice::<3>::from_indices([([0, 0, 0], Kind::Fluid)], DX, H_OVER_DX);
     assert_detected(&lone, |_| true);
 }
+
+/// The tank of `in_a_tank_only_the_top_row_is_surface` with its top row three times as heavy,
+/// as if a second row had been squeezed into it: the top row now holds more mass than a full
+/// support at rest (its emptiest direction, upwards, is still empty, so the moments alone call
+/// it surface), so it is compressed fluid that must push back, not free surface (whose row
+/// fixes the pressure).
+#[test]
+fn compressed_fluid_is_never_free_surface() {
+    let (n, walls) = (16, 4);
+    let points = box_indices([-walls; 2], [n + walls, n])
+        .into_iter()
+        .map(|x| {
+            let fluid = x.iter().all(|&c| (0..n).contains(&c));
+            (x, if fluid { Kind::Fluid } else { Kind::Wall })
+        });
+    let mut lat = Lattice::<2>::from_indices(points, DX, H_OVER_DX);
+    let p = &mut lat.particles;
+    for i in 0..p.len() {
+        if p.is_fluid(i) && (p.pos[1][i] / DX).round() as i64 == n - 1 {
+            p.mass[i] *= 3.0;
+        }
+    }
+    assert_detected(&lat, |_| false);
+}
