@@ -62,10 +62,8 @@ fn a_block_has_exactly_its_outer_layer_on_the_surface() {
     block_outer_layer_only::<3>(11);
 }
 
-/// Water `n` particles wide and deep in a tank with four wall layers on the sides and below:
-/// only the top row is free surface, also where it meets the side walls; fluid against the
-/// walls never is.
-fn tank_top_row_only<const D: usize>(n: i64) {
+/// Water `n` particles wide and deep in a tank with four wall layers on the sides and below.
+fn tank<const D: usize>(n: i64) -> Lattice<D> {
     let walls = 4;
     let lo = [-walls; D];
     let mut hi = [n + walls; D];
@@ -74,8 +72,13 @@ fn tank_top_row_only<const D: usize>(n: i64) {
         let fluid = x.iter().all(|&c| (0..n).contains(&c));
         (x, if fluid { Kind::Fluid } else { Kind::Wall })
     });
-    let lat = Lattice::<D>::from_indices(points, DX, H_OVER_DX);
-    assert_detected(&lat, |x| x[D - 1] == n - 1);
+    Lattice::<D>::from_indices(points, DX, H_OVER_DX)
+}
+
+/// In the `tank`, only the top row is free surface, also where it meets the side walls; fluid
+/// against the walls never is.
+fn tank_top_row_only<const D: usize>(n: i64) {
+    assert_detected(&tank::<D>(n), |x| x[D - 1] == n - 1);
 }
 
 #[test]
@@ -107,14 +110,8 @@ fn sheets_and_a_lone_particle_are_surface() {
 /// fixes the pressure).
 #[test]
 fn compressed_fluid_is_never_free_surface() {
-    let (n, walls) = (16, 4);
-    let points = box_indices([-walls; 2], [n + walls, n])
-        .into_iter()
-        .map(|x| {
-            let fluid = x.iter().all(|&c| (0..n).contains(&c));
-            (x, if fluid { Kind::Fluid } else { Kind::Wall })
-        });
-    let mut lat = Lattice::<2>::from_indices(points, DX, H_OVER_DX);
+    let n = 16;
+    let mut lat = tank::<2>(n);
     let p = &mut lat.particles;
     for i in 0..p.len() {
         if p.is_fluid(i) && (p.pos[1][i] / DX).round() as i64 == n - 1 {

@@ -154,8 +154,9 @@ fn violent_impact_keeps_density_volume_and_order() {
     // The issue asks for < 1% at every step; at the default α = 0.1 the mean density error
     // stays below 0.5% until the plunging wave falls back, then exceeds 1% in 125 of 3,309
     // steps, 1.38% at worst (0.47% on average over the steps), mostly in the row on the floor,
-    // which the one-sided wall condition lifts off its rest distance (docs/stabilisation.md). The worst step is chaotic
-    // (frames every 0.01 s instead of 0.05 s: 1.13%, 6 steps above 1%), the mean is not (0.44%).
+    // which the one-sided wall condition lifts off its rest distance (docs/stabilisation.md).
+    // The worst step is chaotic (frames every 0.01 s instead of 0.05 s: 1.13%, 6 steps above
+    // 1%), the mean is not (0.44%).
     // Bounds: 2% at every step, 0.75% on average.
     let worst = density.iter().cloned().fold(0.0, f64::max);
     let average = density.iter().sum::<f64>() / density.len() as f64;
