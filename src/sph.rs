@@ -307,6 +307,64 @@ pub fn apply_correction<const D: usize>(l: &Correction<D>, v: [f64; D]) -> [f64;
     }
 }
 
+/// φ̃_i, the value at x_i of the linear function a + b·(x − x_i) fitted to the fluid neighbours'
+/// values φ_j (`values`) by least squares weighted by W_ij, particle i itself left out; None
+/// where the neighbours do not fix a linear function (fewer than D + 1 of them, or all on a
+/// line). Exact for linear φ, like φ_i, but blind to φ_i itself (see `step::pressure_gradient`).
+pub fn fitted_value<const D: usize>(nb: &Neighbours<D>, values: &[f64], i: usize) -> Option<f64> {
+    // Normal equations Σ_j W_ij e_j e_jᵀ (a, b) = Σ_j W_ij φ_j e_j with e_j = (1, x_j − x_i),
+    // in the first D + 1 ≤ 4 rows and columns.
+    let n = D + 1;
+    let mut m = [[f64x4::ZERO; 4]; 4];
+    let mut rhs = [f64x4::ZERO; 4];
+    nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+        let w = nb.kernel.w4(l.r) & l.mask;
+        let e: [f64x4; 4] = std::array::from_fn(|a| match a {
+            0 => f64x4::ONE,
+            a if a <= D => -l.rij[a - 1],
+            _ => f64x4::ZERO,
+        });
+        let phi = l.load(values);
+        for a in 0..n {
+            let we = w * e[a];
+            rhs[a] = we.mul_add(phi, rhs[a]);
+            for c in a..n {
+                m[a][c] = we.mul_add(e[c], m[a][c]);
+            }
+        }
+    });
+    let m = std::array::from_fn(|a| std::array::from_fn(|c| m[a.min(c)][a.max(c)].reduce_add()));
+    solve_small(m, rhs.map(|x| x.reduce_add()), n).map(|x| x[0])
+}
+
+/// Solves the first n ≤ 4 rows of m x = b by Gaussian elimination with partial pivoting; None
+/// where a pivot falls below 1e-10 of its column's diagonal entry (m singular to working
+/// precision, as the moments of neighbours that do not span the space).
+fn solve_small(mut m: [[f64; 4]; 4], mut b: [f64; 4], n: usize) -> Option<[f64; 4]> {
+    let scale: [f64; 4] = std::array::from_fn(|k| m[k][k].abs());
+    for k in 0..n {
+        let pivot = (k..n).max_by(|&a, &c| m[a][k].abs().total_cmp(&m[c][k].abs()))?;
+        m.swap(k, pivot);
+        b.swap(k, pivot);
+        if !(m[k][k].abs() > 1e-10 * scale[k]) {
+            return None;
+        }
+        for r in k + 1..n {
+            let f = m[r][k] / m[k][k];
+            for c in k..n {
+                m[r][c] -= f * m[k][c];
+            }
+            b[r] -= f * b[k];
+        }
+    }
+    let mut x = [0.0; 4];
+    for k in (0..n).rev() {
+        let tail: f64 = (k + 1..n).map(|c| m[k][c] * x[c]).sum();
+        x[k] = (b[k] - tail) / m[k][k];
+    }
+    Some(x)
+}
+
 /// Corrected gradient of a scalar field, ∇φ_i = L_i Σ_j V_j (φ_j − φ_i) ∇W_ij, Eq. (20) with
 /// Eq. (24)–(25), with `difference(l)` = φ_j − φ_i of the neighbours in lanes `l`: exact for
 /// linear φ also where the kernel support is truncated.

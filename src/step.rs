@@ -532,8 +532,10 @@ impl<const D: usize> Workspace<D> {
         let corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         let touch = touching_distance(set.spacing);
+        let (roles, full) = (&self.roles, &self.full_support);
         fill_vector(&mut self.velocity, |i| {
-            let grad = pressure_gradient(nb, p, set.ghost_gravity, corrections.of(i), i);
+            let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
+            let grad = pressure_gradient(nb, p, set.ghost_gravity, corrections.of(i), p_ref, i);
             let rho0 = p.rest_density[i];
             let u = std::array::from_fn(|d| u_star[d][i] - dt * grad[d] / rho0);
             faces.no_penetration(p.position(i), u, touch)
@@ -621,7 +623,9 @@ impl<const D: usize> Workspace<D> {
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         let clip = self.reference.is_none();
         fill(&mut self.pressure, |i| {
-            let g = pressure_gradient(nb, p, set.ghost_gravity, pressure_corrections.of(i), i);
+            let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
+            let l = pressure_corrections.of(i);
+            let g = pressure_gradient(nb, p, set.ghost_gravity, l, p_ref, i);
             let dr = vector(shift, i);
             cavitation(
                 clip,
@@ -678,24 +682,55 @@ fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
     }
 }
 
-/// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25) and the walls as
-/// ghosts of its pressure (see `wall`) carrying `ghost_gravity`; across the interface of two
-/// fluids each difference is weighted by `sph::interface_weight`.
+/// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25), the differences
+/// taken from `p_ref` (`pressure_reference`), and the walls as ghosts of P_i (see `wall`)
+/// carrying `ghost_gravity`: a particle whose pressure exceeds p_ref is pushed off a wall it
+/// presses on, but not out through a free surface; across the interface of two fluids each
+/// difference is weighted by `sph::interface_weight`.
 fn pressure_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     ghost_gravity: [f64; D],
     l: &Correction<D>,
+    p_ref: f64,
     i: usize,
 ) -> [f64; D] {
-    let (p_i, rest_density) = (f64x4::splat(p.pressure[i]), f64x4::splat(p.rest_density[i]));
+    let (p_ref, rest_density) = (f64x4::splat(p_ref), f64x4::splat(p.rest_density[i]));
+    // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
+    let own = f64x4::splat(p.pressure[i]) - p_ref;
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
         Kind::Fluid => {
             let weight = sph::interface_weight(rest_density, lanes.load(&p.rest_density));
-            (lanes.load(&p.pressure) - p_i) * weight
+            (lanes.load(&p.pressure) - p_ref) * weight
         }
-        Kind::Wall => wall::ghost_pressure_difference(p, ghost_gravity, i, lanes),
+        Kind::Wall => own + wall::ghost_pressure_difference(p, ghost_gravity, i, lanes),
     })
+}
+
+/// The pressure at fluid particle i that its pressure gradient takes the differences
+/// P_j − P_i from: P_i itself, but for an unknown of the PPE with the free surface in its
+/// kernel support (`role` Interior, not `full_support`) the value P̃_i of the linear function
+/// fitted to its fluid neighbours' pressures (`sph::fitted_value`; P_i where they fix none).
+/// Both are exact for a linear field. Where the surface truncates the support, the difference
+/// form carries the term −P_i L'_i Σ_j V_j ∇W_ij, which points out of the fluid: a particle
+/// whose pressure dips below its neighbours' is pushed towards the surface, and the projection
+/// feeds the velocity that lowered its pressure. On the still tank of `hydrostatic_2d` the
+/// step's velocity map, u ← u − (Δt/ρ0)∇P of the PPE of u, then amplifies a zig-zag of the row
+/// under the surface by 0.32% per step (its largest eigenvalue at rest, by power iteration),
+/// and the tank sloshes after 28 s; with P̃_i the largest eigenvalue is 1, the divergence-free
+/// fields' (docs/stabilisation.md).
+fn pressure_reference<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    role: Role,
+    full_support: bool,
+    i: usize,
+) -> f64 {
+    if role == Role::Interior && !full_support {
+        sph::fitted_value(nb, &p.pressure, i).unwrap_or(p.pressure[i])
+    } else {
+        p.pressure[i]
+    }
 }
 
 /// The pressure the fluid takes: with a free surface the pressure is absolute (zero at the

@@ -1,5 +1,5 @@
 //! Hard cases that must stay numerically stable (the stabilised scheme with its default
-//! settings): still water for 20 s, a violent impact with overturning, high viscosity at the
+//! settings): still water for 30 s, a violent impact with overturning, high viscosity at the
 //! viscous time-step limit, large CFL numbers, a 3D dam break over an obstacle, and particle
 //! disorder with and without shifting.
 
@@ -47,8 +47,8 @@ fn fluid_count(out: &Path, frame: usize) -> usize {
 /// Face crossings per fluid particle and step: `penetrations` counts the particles a step's
 /// advection put beyond a wall face, before the hard contact (`Faces::contact`) puts them
 /// back. At large CFL numbers a particle can move farther than the half spacing between the
-/// fluid and a face in one step, and a few cross (of 1,800 particles, CFL 0.5: 10 in 1,257
-/// steps, CFL 1.0: 88 in 632); this bound (one crossing per 500 particle-steps) says the
+/// fluid and a face in one step, and a few cross (of 1,800 particles, CFL 0.5: 3 in 1,389
+/// steps, CFL 1.0: 52 in 669); this bound (one crossing per 500 particle-steps) says the
 /// walls still stop almost every approach. Also checks that no particle is left beyond a face.
 fn assert_rare_crossings(out: &Path, frames: usize, what: &str) {
     let crossings: f64 = stats_column(out, "penetrations").iter().sum();
@@ -70,8 +70,12 @@ fn assert_no_penetration(out: &Path) {
     );
 }
 
+/// 30 s, not the issue's 20: the mode the near-surface pressure reference removed
+/// (`step::pressure_reference`) let this tank reach 1.6e-3 m/s at 25 s and 0.56 m/s at 30 s;
+/// with it 2.5e-3 m/s at 30 s. A slower surface wave still grows (0.44 m/s at 45 s,
+/// docs/stabilisation.md).
 #[test]
-fn still_water_stays_at_rest_for_20_s() {
+fn still_water_stays_at_rest_for_30_s() {
     // hydrostatic_2d.toml: 40 particles deep, H = 0.5 m.
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hydrostatic_2d.toml"),
@@ -81,7 +85,7 @@ fn still_water_stays_at_rest_for_20_s() {
     let (dx, depth) = (s.spacing, s.blocks[0].region.max[1]);
     assert!(depth / dx >= 40.0);
     let dir = TempDir::new("still_water");
-    let summary = run_scene(&s, dir.path(), 20.0);
+    let summary = run_scene(&s, dir.path(), 30.0);
     let out = dir.path();
     let last = summary.frames.len() - 1;
     let rho_g_h = s.fluids[0].density * G * depth;
@@ -151,18 +155,16 @@ fn violent_impact_keeps_density_volume_and_order() {
     let (dir, frames) = violent_impact("", "impact");
     let out = dir.path();
     let density = stats_column(out, "density_error");
-    // The issue asks for < 1% at every step; at the default α = 0.1 the mean density error
-    // stays below 0.5% until the plunging wave falls back, then exceeds 1% in 125 of 3,309
-    // steps, 1.38% at worst (0.47% on average over the steps), mostly in the row on the floor,
-    // which the one-sided wall condition lifts off its rest distance (docs/stabilisation.md).
-    // The worst step is chaotic (frames every 0.01 s instead of 0.05 s: 1.13%, 6 steps above
-    // 1%), the mean is not (0.44%).
-    // Bounds: 2% at every step, 0.75% on average.
+    // The issue asks for < 1% at every step. Measured (docs/stabilisation.md): 0.91% at worst
+    // over 3,349 steps, 0.41% on average; frames every 0.01 s instead of 0.05 s (a different
+    // trajectory of this chaotic flow after the plunge): 1.00% at worst, 0.43% on average.
+    // Before the near-surface pressure reference of `step::pressure_reference`: 1.38% at worst,
+    // 125 steps above 1%.
     let worst = density.iter().cloned().fold(0.0, f64::max);
     let average = density.iter().sum::<f64>() / density.len() as f64;
-    assert!(worst < 0.02, "mean density error reached {worst}");
+    assert!(worst < 0.01, "mean density error reached {worst}");
     assert!(
-        average < 0.0075,
+        average < 0.006,
         "mean density error {average} on average over the steps"
     );
     assert_no_penetration(out);
@@ -235,10 +237,10 @@ fn high_viscosity_stays_smooth() {
 }
 
 /// The violent impact at CFL 0.5 and 1.0 (the default is 0.2): no NaN, rare face crossings, no
-/// energy created, and the mean density error bounded — 0.8–0.9% on average over the steps at
-/// 0.5 (chaotic: frames 0.0499 s apart instead of 0.05 s give 0.80%), 3.4% at 1.0 (a larger
-/// step lets more compression through before the projection catches it): asserted below 1%
-/// and 5%.
+/// energy created, and the mean density error bounded — 0.63% on average over the steps at
+/// 0.5 (0.8–0.9% before the near-surface pressure reference of `step::pressure_reference`),
+/// 2.7% at 1.0 (3.4% before; a larger step lets more compression through before the
+/// projection catches it): asserted below 1% and 5%.
 #[test]
 fn large_cfl_numbers_stay_stable() {
     for (cfl, bound) in [(0.5, 0.01), (1.0, 0.05)] {
