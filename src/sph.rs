@@ -346,7 +346,9 @@ fn solve_small(mut m: [[f64; 4]; 4], mut b: [f64; 4], n: usize) -> Option<[f64; 
         let pivot = (k..n).max_by(|&a, &c| m[a][k].abs().total_cmp(&m[c][k].abs()))?;
         m.swap(k, pivot);
         b.swap(k, pivot);
-        if !(m[k][k].abs() > 1e-10 * scale[k]) {
+        // Written so that a NaN pivot fails too.
+        let independent = m[k][k].abs() > 1e-10 * scale[k];
+        if !independent {
             return None;
         }
         for r in k + 1..n {
