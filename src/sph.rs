@@ -5,7 +5,7 @@ use crate::neighbours::Lanes;
 pub use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
 use crate::wall::{behind_walls, ghost_velocity, Face};
-use wide::f64x4;
+use wide::{f64x4, CmpEq};
 
 /// Summation density ρ_i = Σ_j m_j (ρ0_i/ρ0_j) W_ij = ρ0_i Σ_j V_j W_ij (self included): the
 /// familiar Σ_j m_j W_ij where the support holds one fluid, while across the interface of two
@@ -307,64 +307,62 @@ pub fn apply_correction<const D: usize>(l: &Correction<D>, v: [f64; D]) -> [f64;
     }
 }
 
-/// φ̃_i, the value at x_i of the linear function a + b·(x − x_i) fitted to the fluid neighbours'
-/// values φ_j (`values`) by least squares weighted by W_ij, particle i itself left out; None
-/// where the neighbours do not fix a linear function (fewer than D + 1 of them, or all on a
-/// line). Exact for linear φ, like φ_i, but blind to φ_i itself (see `step::pressure_gradient`).
-pub fn fitted_value<const D: usize>(nb: &Neighbours<D>, values: &[f64], i: usize) -> Option<f64> {
-    // Normal equations Σ_j W_ij e_j e_jᵀ (a, b) = Σ_j W_ij φ_j e_j with e_j = (1, x_j − x_i),
-    // in the first D + 1 ≤ 4 rows and columns.
-    let n = D + 1;
-    let mut m = [[f64x4::ZERO; 4]; 4];
-    let mut rhs = [f64x4::ZERO; 4];
+/// Smallest det C / (tr C / D)^D of the neighbours' positions for which `fitted_value` fits
+/// a linear function: 1 for an isotropic spread, 0.77 for a particle on a flat free surface,
+/// 0.63 in a sheet two particles thick (2D lattice, h = 1.2 dx), 0 on a line.
+const MIN_FIT_ISOTROPY: f64 = 0.01;
+
+/// φ̃_i, the value at x_i of the linear function φ̄ + b·(x − x̄) fitted to the values φ_j
+/// (`values`) of the fluid neighbours of i's own fluid (same rest density: across an interface
+/// the hydrostatic pressure bends) by least squares weighted by W_ij, particle i itself left
+/// out; x̄ and φ̄ are their weighted means and b = C⁻¹ Σ_j W_ij (x_j − x̄)(φ_j − φ̄), C their
+/// weighted covariance. None where the neighbours do not fix a linear function: fewer than
+/// D + 1 of them, or spread along too few directions (a thin sheet, a line of particles):
+/// det C below `MIN_FIT_ISOTROPY` of (tr C / D)^D, the value of an isotropic spread.
+/// Exact for linear φ, like φ_i, but blind to φ_i itself (see `step::pressure_reference`).
+pub fn fitted_value<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    values: &[f64],
+    i: usize,
+) -> Option<f64> {
+    let own_fluid = f64x4::splat(p.rest_density[i]);
+    // Weighted sums of 1, d = x_j − x_i, φ, d dᵀ and d φ.
+    let (mut w_sum, mut phi_sum) = (f64x4::ZERO, f64x4::ZERO);
+    let mut d_sum = [f64x4::ZERO; D];
+    let mut dd_sum = [[f64x4::ZERO; D]; D];
+    let mut dphi_sum = [f64x4::ZERO; D];
     nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-        let w = nb.kernel.w4(l.r) & l.mask;
-        let e: [f64x4; 4] = std::array::from_fn(|a| match a {
-            0 => f64x4::ONE,
-            a if a <= D => -l.rij[a - 1],
-            _ => f64x4::ZERO,
-        });
-        let phi = l.load(values);
-        for a in 0..n {
-            let we = w * e[a];
-            rhs[a] = we.mul_add(phi, rhs[a]);
-            for c in a..n {
-                m[a][c] = we.mul_add(e[c], m[a][c]);
+        let same = l.load(&p.rest_density).cmp_eq(own_fluid);
+        let w = nb.kernel.w4(l.r) & l.mask & same;
+        let phi = l.load(values) & l.mask;
+        w_sum += w;
+        phi_sum = w.mul_add(phi, phi_sum);
+        for a in 0..D {
+            let wd = -w * l.rij[a];
+            d_sum[a] += wd;
+            dphi_sum[a] = wd.mul_add(phi, dphi_sum[a]);
+            for b in a..D {
+                dd_sum[a][b] = wd.mul_add(-l.rij[b], dd_sum[a][b]);
             }
         }
     });
-    let m = std::array::from_fn(|a| std::array::from_fn(|c| m[a.min(c)][a.max(c)].reduce_add()));
-    solve_small(m, rhs.map(|x| x.reduce_add()), n).map(|x| x[0])
-}
-
-/// Solves the first n ≤ 4 rows of m x = b by Gaussian elimination with partial pivoting; None
-/// where a pivot falls below 1e-10 of its column's diagonal entry (m singular to working
-/// precision, as the moments of neighbours that do not span the space).
-fn solve_small(mut m: [[f64; 4]; 4], mut b: [f64; 4], n: usize) -> Option<[f64; 4]> {
-    let scale: [f64; 4] = std::array::from_fn(|k| m[k][k].abs());
-    for k in 0..n {
-        let pivot = (k..n).max_by(|&a, &c| m[a][k].abs().total_cmp(&m[c][k].abs()))?;
-        m.swap(k, pivot);
-        b.swap(k, pivot);
-        // Written so that a NaN pivot fails too.
-        let independent = m[k][k].abs() > 1e-10 * scale[k];
-        if !independent {
-            return None;
-        }
-        for r in k + 1..n {
-            let f = m[r][k] / m[k][k];
-            for c in k..n {
-                m[r][c] -= f * m[k][c];
-            }
-            b[r] -= f * b[k];
-        }
+    let w = w_sum.reduce_add();
+    let d_mean = d_sum.map(|x| x.reduce_add() / w);
+    let phi_mean = phi_sum.reduce_add() / w;
+    let covariance: [[f64; D]; D] = std::array::from_fn(|a| {
+        std::array::from_fn(|b| dd_sum[a.min(b)][a.max(b)].reduce_add() - w * d_mean[a] * d_mean[b])
+    });
+    let cross: [f64; D] =
+        std::array::from_fn(|a| dphi_sum[a].reduce_add() - w * d_mean[a] * phi_mean);
+    let spread = (0..D).map(|a| covariance[a][a]).sum::<f64>() / D as f64;
+    let (inverse, det) = invert(covariance)?;
+    let spans = w > 0.0 && det > MIN_FIT_ISOTROPY * spread.powi(D as i32);
+    if !spans {
+        return None;
     }
-    let mut x = [0.0; 4];
-    for k in (0..n).rev() {
-        let tail: f64 = (k + 1..n).map(|c| m[k][c] * x[c]).sum();
-        x[k] = (b[k] - tail) / m[k][k];
-    }
-    Some(x)
+    let slope = apply_correction(&Some(inverse), cross);
+    Some(phi_mean - (0..D).map(|a| slope[a] * d_mean[a]).sum::<f64>())
 }
 
 /// Corrected gradient of a scalar field, ∇φ_i = L_i Σ_j V_j (φ_j − φ_i) ∇W_ij, Eq. (20) with

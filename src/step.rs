@@ -727,7 +727,7 @@ fn pressure_reference<const D: usize>(
     i: usize,
 ) -> f64 {
     if role == Role::Interior && !full_support {
-        sph::fitted_value(nb, &p.pressure, i).unwrap_or(p.pressure[i])
+        sph::fitted_value(nb, p, &p.pressure, i).unwrap_or(p.pressure[i])
     } else {
         p.pressure[i]
     }

@@ -18,6 +18,11 @@ pub struct Lattice<const D: usize> {
 
 impl<const D: usize> Lattice<D> {
     pub fn new(n: i64, dx: f64, h_over_dx: f64) -> Self {
+        Self::part(n, dx, h_over_dx, |_| true)
+    }
+
+    /// The points of `new` whose lattice index `keep` accepts.
+    pub fn part(n: i64, dx: f64, h_over_dx: f64, keep: impl Fn(&[i64; D]) -> bool) -> Self {
         let half = n / 2;
         let total = (n as usize).pow(D as u32);
         let points = (0..total).map(|k| {
@@ -29,7 +34,7 @@ impl<const D: usize> Lattice<D> {
             });
             (index, Kind::Fluid)
         });
-        Self::from_indices(points, dx, h_over_dx)
+        Self::from_indices(points.filter(|(index, _)| keep(index)), dx, h_over_dx)
     }
 
     /// Particles at lattice indices (position = index · dx) of the given kinds.

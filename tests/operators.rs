@@ -37,45 +37,37 @@ fn laplacian_of_a_quadratic_is_the_exact_constant() {
     }
 }
 
-/// A half lattice, y ≤ 0 (the row at y = 0 the free surface), in 2D and 3D.
-fn half_lattice<const D: usize>(n: i64) -> Lattice<D> {
-    let half = n / 2;
-    let points = (0..(n as usize).pow(D as u32)).filter_map(|k| {
-        let mut rest = k as i64;
-        let index: [i64; D] = std::array::from_fn(|_| {
-            let c = rest % n;
-            rest /= n;
-            c - half
-        });
-        (index[1] <= 0).then_some((index, Kind::Fluid))
-    });
-    Lattice::from_indices(points, 0.01, 1.2)
-}
-
 fn fitted_value_is_exact_for_linear_fields_and_blind_to_its_own<const D: usize>(n: i64) {
-    let lat = half_lattice::<D>(n);
+    // A half lattice, y ≤ 0: the row at y = 0 is a free surface.
+    let lat = Lattice::<D>::part(n, 0.01, 1.2, |index| index[1] <= 0);
     let p = &lat.particles;
     let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
-    // A hydrostatic-like field, P = 1000 − 9810 y + 300 x, at the surface row's centre and a
-    // row below it (both truncated supports).
+    // A hydrostatic-like field with a slope along x too.
     let mut pressure: Vec<f64> = (0..p.len())
         .map(|i| 1000.0 - 9810.0 * p.pos[1][i] + 300.0 * p.pos[0][i])
         .collect();
-    let centre = lat.centre();
-    let below = (0..p.len())
-        .find(|&i| {
-            (p.pos[1][i] + 0.01).abs() < 1e-9 && (0..D).all(|d| d == 1 || p.pos[d][i].abs() < 1e-9)
-        })
-        .unwrap();
-    for i in [centre, below] {
+    // On the surface row's centre, a row below it, and the surface row's corner, where the
+    // neighbours lie to one side along x as well.
+    let at = |x: f64, y: f64| {
+        (0..p.len())
+            .find(|&i| {
+                (0..D).all(|d| {
+                    let want = [x, y].get(d).copied().unwrap_or(0.0);
+                    (p.pos[d][i] - want).abs() < 1e-9
+                })
+            })
+            .unwrap()
+    };
+    let corner = -0.01 * (n / 2) as f64;
+    for i in [at(0.0, 0.0), at(0.0, -0.01), at(corner, 0.0)] {
         let exact = pressure[i];
-        let fitted = fitted_value(&nb, &pressure, i).expect("a full half support fixes a plane");
+        let fitted = fitted_value(&nb, p, &pressure, i).expect("a half support fixes a plane");
         assert!(
             (fitted - exact).abs() < 1e-9 * exact.abs(),
             "{D}D: {fitted} vs {exact}"
         );
         pressure[i] += 500.0;
-        let blind = fitted_value(&nb, &pressure, i).unwrap();
+        let blind = fitted_value(&nb, p, &pressure, i).unwrap();
         assert!(
             (blind - exact).abs() < 1e-9 * exact.abs(),
             "{D}D: own value leaked: {blind}"
@@ -92,17 +84,19 @@ fn fitted_value_is_exact_for_linear_fields_and_ignores_the_particle_itself() {
 
 #[test]
 fn fitted_value_is_none_where_the_neighbours_fix_no_plane() {
-    // Three particles on a line: the neighbours of the middle one cannot fix the slope across.
-    let lat = Lattice::<2>::from_indices(
-        [
-            ([-1, 0], Kind::Fluid),
-            ([0, 0], Kind::Fluid),
-            ([1, 0], Kind::Fluid),
-        ],
-        0.01,
-        1.2,
-    );
-    let p = &lat.particles;
-    let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
-    assert_eq!(fitted_value(&nb, &[1.0, 2.0, 3.0], lat.centre()), None);
+    // A row of particles: the neighbours of (0, 0) fix no slope across it, also with two more
+    // at the kernel's rim off the row (det C / (tr C / 2)² = 5e-4, invertible, but noise
+    // across); one particle beside the row fixes the plane (0.61).
+    let fit = |points: &[[i64; 2]]| {
+        let lat = Lattice::<2>::from_indices(points.iter().map(|&x| (x, Kind::Fluid)), 0.01, 1.2);
+        let p = &lat.particles;
+        let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
+        let values: Vec<f64> = (0..p.len()).map(|i| p.pos[0][i] + p.pos[1][i]).collect();
+        fitted_value(&nb, p, &values, lat.centre())
+    };
+    let row = [[-2, 0], [-1, 0], [0, 0], [1, 0], [2, 0]];
+    assert_eq!(fit(&row), None);
+    assert_eq!(fit(&[&row[..], &[[-3, -1], [3, 1]]].concat()), None);
+    let beside = fit(&[&row[..], &[[0, 1]]].concat()).expect("a plane");
+    assert!(beside.abs() < 1e-12, "{beside}");
 }
