@@ -72,7 +72,7 @@ fn assert_no_penetration(out: &Path) {
 
 /// 30 s, not the 20: the mode the near-surface pressure reference removed
 /// (`step::pressure_reference`) let this tank reach 1.6e-3 m/s at 25 s and 0.56 m/s at 30 s;
-/// with it 2.5e-3 m/s at 30 s. A slower surface wave still grows (0.44 m/s at 45 s,
+/// with it 2.3e-3 m/s at 30 s. A slower surface wave still grows (0.13 m/s at 40 s,
 /// docs/stabilisation.md).
 #[test]
 fn still_water_stays_at_rest_for_30_s() {
