@@ -1,7 +1,7 @@
 //! The quintic spline kernel of Eq. (19) (Schoenberg / Morris 1997), support radius 3h.
 
+use crate::lanes::F64s;
 use std::f64::consts::PI;
-use wide::{f64x4, CmpEq};
 
 /// Support radius in units of the smoothing length h.
 pub const SUPPORT_IN_H: f64 = 3.0;
@@ -67,37 +67,37 @@ impl<const D: usize> Quintic<D> {
 
     /// W(r) in lanes.
     #[inline(always)]
-    pub fn w4(&self, r: f64x4) -> f64x4 {
+    pub fn w4(&self, r: F64s) -> F64s {
         let [a, b, c] = self.spline_terms4(r);
-        let p5 = |x: f64x4| (x * x) * (x * x) * x;
-        f64x4::splat(self.norm)
-            * f64x4::splat(15.0).mul_add(p5(c), f64x4::splat(-6.0).mul_add(p5(b), p5(a)))
+        let p5 = |x: F64s| (x * x) * (x * x) * x;
+        F64s::splat(self.norm)
+            * F64s::splat(15.0).mul_add(p5(c), F64s::splat(-6.0).mul_add(p5(b), p5(a)))
     }
 
     /// F(r) = W'(r)/r in lanes (W''(0) where r = 0, as `grad_factor`).
     #[inline(always)]
-    pub fn grad_factor4(&self, r: f64x4) -> f64x4 {
+    pub fn grad_factor4(&self, r: F64s) -> F64s {
         let (dw_dr, at_zero) = self.derivative4(r);
-        at_zero.blend(f64x4::splat(self.grad_factor(0.0)), dw_dr / r)
+        at_zero.select(F64s::splat(self.grad_factor(0.0)), dw_dr / r)
     }
 
     /// W'(r) in lanes, and the mask of the lanes with r = 0.
     #[inline(always)]
-    pub fn derivative4(&self, r: f64x4) -> (f64x4, f64x4) {
+    pub fn derivative4(&self, r: F64s) -> (F64s, F64s) {
         let [a, b, c] = self.spline_terms4(r);
-        let p4 = |x: f64x4| (x * x) * (x * x);
-        let dw_dq = f64x4::splat(-5.0)
-            * f64x4::splat(15.0).mul_add(p4(c), f64x4::splat(-6.0).mul_add(p4(b), p4(a)));
+        let p4 = |x: F64s| (x * x) * (x * x);
+        let dw_dq = F64s::splat(-5.0)
+            * F64s::splat(15.0).mul_add(p4(c), F64s::splat(-6.0).mul_add(p4(b), p4(a)));
         (
-            f64x4::splat(self.norm * self.inv_h) * dw_dq,
-            r.cmp_eq(f64x4::ZERO),
+            F64s::splat(self.norm * self.inv_h) * dw_dq,
+            r.simd_eq(F64s::ZERO),
         )
     }
 
     /// (3 − q)₊, (2 − q)₊, (1 − q)₊ with q = r/h.
     #[inline(always)]
-    fn spline_terms4(&self, r: f64x4) -> [f64x4; 3] {
-        let q = r * f64x4::splat(self.inv_h);
-        [3.0, 2.0, 1.0].map(|k| (f64x4::splat(k) - q).fast_max(f64x4::ZERO))
+    fn spline_terms4(&self, r: F64s) -> [F64s; 3] {
+        let q = r * F64s::splat(self.inv_h);
+        [3.0, 2.0, 1.0].map(|k| (F64s::splat(k) - q).fast_max(F64s::ZERO))
     }
 }

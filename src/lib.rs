@@ -14,6 +14,7 @@ pub mod free_surface;
 pub mod grid;
 pub mod io;
 pub mod kernel;
+pub mod lanes;
 pub mod lattice;
 pub mod linsolve;
 pub mod memory;

@@ -1,8 +1,8 @@
 //! The pair loop every operator is built on. The particles are sorted by kind and cell (`grid`),
 //! so the neighbours of particle i lie in a few contiguous index ranges, one per row of cells
 //! within reach and kind (operators that need one kind only visit its ranges); the loop walks each range
-//! four particles at a time in SIMD lanes (`wide::f64x4`): positions are loaded contiguously,
-//! the distance test and the kernel are evaluated for four pairs at once, and each operator
+//! `LANES` particles at a time in SIMD lanes (`lanes::F64s`): positions are loaded contiguously,
+//! the distance test and the kernel are evaluated for `LANES` pairs at once, and each operator
 //! accumulates in lanes, summed at the end in a fixed order. Lanes past the end of a range (and
 //! past the end of the arrays, which read far-away sentinels) are masked off.
 //!
@@ -11,35 +11,33 @@
 
 use crate::grid::{CellList, KINDS};
 use crate::kernel::Quintic;
+use crate::lanes::{F64s, LANES};
 use crate::particles::Kind;
-use wide::{f64x4, CmpLt};
 
 /// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
 const ETA2_IN_H2: f64 = 1.0e-4;
-/// Lanes per SIMD chunk.
-pub const LANES: usize = 4;
 /// Coordinate of the lanes past the end of the arrays: farther than any support.
 const SENTINEL: f64 = 1.0e30;
 
-/// Four consecutive candidate neighbours j0 … j0+3 of particle i.
+/// `LANES` consecutive candidate neighbours j0 … j0 + LANES − 1 of particle i.
 #[derive(Clone, Copy, Debug)]
 pub struct Lanes<const D: usize> {
     /// Index of the first lane.
     pub j0: usize,
     /// r_ij = r_i − r_j per lane.
-    pub rij: [f64x4; D],
+    pub rij: [F64s; D],
     /// |r_ij| per lane (0 where masked).
-    pub r: f64x4,
+    pub r: F64s,
     /// All bits set in the lanes that are neighbours (inside the support, j ≠ i), zero elsewhere.
-    pub mask: f64x4,
-    /// The kind of the four candidates (a range holds particles of one kind).
+    pub mask: F64s,
+    /// The kind of the candidates (a range holds particles of one kind).
     pub kind: Kind,
 }
 
 impl<const D: usize> Lanes<D> {
-    /// `a[j0 .. j0 + 4]`, zero past the end of `a`.
+    /// `a[j0 .. j0 + LANES]`, zero past the end of `a`.
     #[inline(always)]
-    pub fn load(&self, a: &[f64]) -> f64x4 {
+    pub fn load(&self, a: &[f64]) -> F64s {
         load(a, self.j0, 0.0)
     }
 
@@ -49,19 +47,19 @@ impl<const D: usize> Lanes<D> {
         self.mask.to_array()[k] != 0.0
     }
 
-    /// The neighbours among the four lanes.
+    /// The neighbours among the lanes.
     #[inline(always)]
     pub fn count(&self) -> usize {
-        self.mask.move_mask().count_ones() as usize
+        self.mask.to_bitmask().count_ones() as usize
     }
 }
 
-/// a[j0 .. j0 + 4] with `fill` past the end of `a`.
+/// a[j0 .. j0 + LANES] with `fill` past the end of `a`.
 #[inline(always)]
-fn load(a: &[f64], j0: usize, fill: f64) -> f64x4 {
+fn load(a: &[f64], j0: usize, fill: f64) -> F64s {
     match a.get(j0..j0 + LANES) {
-        Some(s) => f64x4::from(<[f64; LANES]>::try_from(s).expect("four lanes")),
-        None => f64x4::from(std::array::from_fn(|k| {
+        Some(s) => F64s::from(<[f64; LANES]>::try_from(s).expect("LANES lanes")),
+        None => F64s::from(std::array::from_fn(|k| {
             a.get(j0 + k).copied().unwrap_or(fill)
         })),
     }
@@ -97,7 +95,7 @@ impl<'a, const D: usize> Neighbours<'a, D> {
         self.grid
     }
 
-    /// The pair loop in lanes: calls `f` with every chunk of four candidates around particle
+    /// The pair loop in lanes: calls `f` with every chunk of `LANES` candidates around particle
     /// i that holds at least one neighbour, over the particles of every kind.
     #[inline(always)]
     pub fn for_each_lanes(&self, i: usize, f: impl FnMut(&Lanes<D>)) {
@@ -108,17 +106,17 @@ impl<'a, const D: usize> Neighbours<'a, D> {
     #[inline(always)]
     pub fn for_each_lanes_of(&self, i: usize, kinds: &[Kind], mut f: impl FnMut(&Lanes<D>)) {
         let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
-        let support2 = f64x4::splat(self.support2);
+        let support2 = F64s::splat(self.support2);
         // `xi` is i's image next to the range (itself but across a periodic boundary).
         self.grid
             .for_each_neighbour_range(xi, kinds, |range, xi, kind| {
                 let mut j0 = range.start;
                 while j0 < range.end {
-                    let rij: [f64x4; D] = std::array::from_fn(|d| {
-                        f64x4::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL)
+                    let rij: [F64s; D] = std::array::from_fn(|d| {
+                        F64s::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL)
                     });
-                    let r2 = rij.iter().fold(f64x4::ZERO, |s, x| x.mul_add(*x, s));
-                    let mut mask = r2.cmp_lt(support2);
+                    let r2 = rij.iter().fold(F64s::ZERO, |s, x| x.mul_add(*x, s));
+                    let mut mask = r2.simd_lt(support2);
                     let own = i.wrapping_sub(j0);
                     if own < LANES || j0 + LANES > range.end {
                         let mut bits = mask.to_array();
@@ -127,7 +125,7 @@ impl<'a, const D: usize> Neighbours<'a, D> {
                                 *bit = 0.0;
                             }
                         }
-                        mask = f64x4::from(bits);
+                        mask = F64s::from(bits);
                     }
                     if mask.any() {
                         let r = (r2 & mask).sqrt();
@@ -173,12 +171,12 @@ impl<'a, const D: usize> Neighbours<'a, D> {
 
     /// F(r) = W'(r)/r and r² F/(r² + η²) (`laplacian_factor`) in lanes, with one division.
     #[inline(always)]
-    pub fn gradient_and_laplacian_factors4(&self, r: f64x4) -> (f64x4, f64x4) {
+    pub fn gradient_and_laplacian_factors4(&self, r: F64s) -> (F64s, F64s) {
         let (dw_dr, at_zero) = self.kernel.derivative4(r);
         let r2 = r * r;
-        let r2_eta2 = r2 + f64x4::splat(self.eta2);
-        let inv = f64x4::ONE / (r * r2_eta2).fast_max(f64x4::splat(f64::MIN_POSITIVE));
-        let f = at_zero.blend(f64x4::splat(self.f_at_zero), dw_dr * r2_eta2 * inv);
+        let r2_eta2 = r2 + F64s::splat(self.eta2);
+        let inv = F64s::ONE / (r * r2_eta2).fast_max(F64s::splat(f64::MIN_POSITIVE));
+        let f = at_zero.select(F64s::splat(self.f_at_zero), dw_dr * r2_eta2 * inv);
         (f, dw_dr * r2 * inv)
     }
 }

@@ -15,9 +15,11 @@
 //! first in the sorted order).
 
 use crate::free_surface::Support;
+use crate::lanes::F64s;
+use crate::lanes::LANES;
 use crate::linsolve::LinearOperator;
 use crate::multigrid::{stencil_slot, Aggregated};
-use crate::neighbours::{Lanes, LANES};
+use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
 use crate::sph::{
@@ -25,7 +27,6 @@ use crate::sph::{
 };
 use crate::wall::{behind_walls, ghost_pressure_difference, ghost_velocity};
 use rayon::prelude::*;
-use wide::f64x4;
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -264,7 +265,7 @@ fn divergence_source<const D: usize>(
     // divergence (see `wall::ghost_velocity`).
     let u_star_i: [f64; D] = std::array::from_fn(|d| u_star[d][i]);
     let u_i = p.velocity(i);
-    let velocity = |l: &Lanes<D>| -> [f64x4; D] {
+    let velocity = |l: &Lanes<D>| -> [F64s; D] {
         match l.kind {
             Kind::Wall => ghost_velocity(p, l, u_star_i, u_i),
             Kind::Fluid => std::array::from_fn(|d| l.load(&u_star[d])),
@@ -296,9 +297,9 @@ fn divergence_source<const D: usize>(
 fn laplacian_mass<const D: usize>(
     p: &Particles<D>,
     interfaces: bool,
-    rest_density: f64x4,
+    rest_density: F64s,
     l: &Lanes<D>,
-) -> f64x4 {
+) -> F64s {
     if !interfaces {
         return l.load(&p.mass);
     }
@@ -327,9 +328,9 @@ fn laplacian_correction<const D: usize>(
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    let mut c = [f64x4::ZERO; D];
-    let scale = f64x4::splat(2.0 / p.rest_density[i]);
-    let rest_density = f64x4::splat(p.rest_density[i]);
+    let mut c = [F64s::ZERO; D];
+    let scale = F64s::splat(2.0 / p.rest_density[i]);
+    let rest_density = F64s::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |lanes| {
         let (_, laplacian_factor) = nb.gradient_and_laplacian_factors4(lanes.r);
         // −a_ij of Eq. (27) (`sph::laplacian_coefficient`).
@@ -368,18 +369,18 @@ pub struct PressureOperator<'a, const D: usize> {
 
 /// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
 struct Row<const D: usize> {
-    scale: f64x4,
-    c: [f64x4; D],
+    scale: F64s,
+    c: [F64s; D],
     /// ρ0_i.
-    rest_density: f64x4,
+    rest_density: F64s,
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
     fn row_constants(&self, i: usize) -> Row<D> {
         Row {
-            scale: f64x4::splat(-2.0 / self.p.rest_density[i]),
-            c: std::array::from_fn(|d| f64x4::splat(self.row_vectors[d][i])),
-            rest_density: f64x4::splat(self.p.rest_density[i]),
+            scale: F64s::splat(-2.0 / self.p.rest_density[i]),
+            c: std::array::from_fn(|d| F64s::splat(self.row_vectors[d][i])),
+            rest_density: F64s::splat(self.p.rest_density[i]),
         }
     }
 
@@ -387,20 +388,20 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// `mass` and `volume` the masses m̃_j (`laplacian_mass`) and volumes V_j of the lanes:
     /// max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij = −(2 m̃_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
     #[inline(always)]
-    fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, mass: f64x4, volume: f64x4) -> f64x4 {
+    fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, mass: F64s, volume: F64s) -> F64s {
         let (f, laplacian_factor) = self.nb.gradient_and_laplacian_factors4(l.r);
         let laplacian = row.scale * mass * laplacian_factor;
-        let c_r = (0..D).fold(f64x4::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
+        let c_r = (0..D).fold(F64s::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
         let correction = volume * f * c_r;
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
-        (laplacian - correction).fast_max(f64x4::ZERO) & l.mask
+        (laplacian - correction).fast_max(F64s::ZERO) & l.mask
     }
 
     /// The weights of interior row i with its fluid neighbours `l`.
     #[inline(always)]
-    fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> f64x4 {
+    fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> F64s {
         let mass = laplacian_mass(self.p, self.interfaces, row.rest_density, l);
         self.interior_weights(row, l, mass, l.load(self.fluid_volume))
     }
@@ -409,7 +410,7 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// differences.
     fn wall_source(&self, i: usize) -> f64 {
         let (p, row) = (self.p, self.row_constants(i));
-        let mut b = f64x4::ZERO;
+        let mut b = F64s::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
             let volume = l.load(&p.mass) / l.load(&p.rest_density);
             let mass = laplacian_mass(p, self.interfaces, row.rest_density, l);
@@ -425,8 +426,8 @@ impl<const D: usize> PressureOperator<'_, D> {
     fn row(&self, x: &[f64], i: usize) -> f64 {
         match self.roles[i] {
             Role::Interior => {
-                let (xi, row) = (f64x4::splat(x[i]), self.row_constants(i));
-                let mut ax = f64x4::ZERO;
+                let (xi, row) = (F64s::splat(x[i]), self.row_constants(i));
+                let mut ax = F64s::ZERO;
                 self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
                     ax = self.fluid_weights(&row, l).mul_add(xi - l.load(x), ax);
                 });
@@ -449,7 +450,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
     fn diagonal(&self, diag: &mut [f64]) {
         let nb = self.nb;
         fill(diag, |i| {
-            let mut d = f64x4::ZERO;
+            let mut d = F64s::ZERO;
             match self.roles[i] {
                 Role::Interior => {
                     let row = self.row_constants(i);

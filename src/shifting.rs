@@ -19,9 +19,9 @@
 //! Velocity and pressure are then carried to the shifted position by Eq. (9),
 //! φ' = φ + (∇φ)·δr.
 
+use crate::lanes::F64s;
 use crate::particles::Particles;
 use crate::sph::{volume_gradient_factor, Neighbours};
-use wide::f64x4;
 
 /// The constants of shifting (the scene's `[effects.shifting]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,15 +80,15 @@ impl Shifting {
         full_support: bool,
         i: usize,
     ) -> [f64; D] {
-        let mut grad = [f64x4::ZERO; D];
+        let mut grad = [F64s::ZERO; D];
         let (inv_w_dx, weight) = (
-            f64x4::splat(1.0 / self.w_dx),
-            f64x4::splat(self.clustering_weight),
+            F64s::splat(1.0 / self.w_dx),
+            F64s::splat(self.clustering_weight),
         );
         nb.for_each_lanes(i, |l| {
             let ratio = nb.kernel.w4(l.r) * inv_w_dx;
             let ratio2 = ratio * ratio;
-            let c = volume_gradient_factor(nb, p, l) * weight.mul_add(ratio2 * ratio2, f64x4::ONE);
+            let c = volume_gradient_factor(nb, p, l) * weight.mul_add(ratio2 * ratio2, F64s::ONE);
             for d in 0..D {
                 grad[d] = c.mul_add(l.rij[d], grad[d]);
             }

@@ -1,19 +1,19 @@
 //! SPH discretisation: the operators of Eq. (20)–(27) written as per-particle sums over the
 //! pair loop of `neighbours`.
 
+use crate::lanes::F64s;
 use crate::neighbours::Lanes;
 pub use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
 use crate::wall::{behind_walls, ghost_velocity, Face};
-use wide::{f64x4, CmpEq};
 
 /// Summation density ρ_i = Σ_j m_j (ρ0_i/ρ0_j) W_ij = ρ0_i Σ_j V_j W_ij (self included): the
 /// familiar Σ_j m_j W_ij where the support holds one fluid, while across the interface of two
 /// fluids each neighbour counts with its volume (Hu & Adams 2006), so that water beside oil
 /// is not taken for expanded (below 0.9 ρ0 it would be spray) nor the oil for compressed.
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
-    let mut rho = f64x4::ZERO;
-    let rho0_i = f64x4::splat(p.rest_density[i]);
+    let mut rho = F64s::ZERO;
+    let rho0_i = F64s::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |l| {
         rho = ((mass_at_density(p, rho0_i, l) * nb.kernel.w4(l.r)) & l.mask) + rho;
     });
@@ -25,9 +25,9 @@ pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -
 #[inline(always)]
 pub fn mass_at_density<const D: usize>(
     p: &Particles<D>,
-    rest_density_i: f64x4,
+    rest_density_i: F64s,
     l: &Lanes<D>,
-) -> f64x4 {
+) -> F64s {
     l.load(&p.mass) * (rest_density_i / l.load(&p.rest_density))
 }
 
@@ -38,8 +38,8 @@ pub fn mass_at_density<const D: usize>(
 /// ∇P_i/ρ0_i = g on both sides, where the plain difference P_j − P_i averages the two
 /// fluids' hydrostatic gradients and pushes the particles beside the interface.
 #[inline(always)]
-pub fn interface_weight(rest_density_i: f64x4, rest_density_j: f64x4) -> f64x4 {
-    f64x4::splat(2.0) * rest_density_i / (rest_density_i + rest_density_j)
+pub fn interface_weight(rest_density_i: F64s, rest_density_j: F64s) -> F64s {
+    F64s::splat(2.0) * rest_density_i / (rest_density_i + rest_density_j)
 }
 
 /// V_j F(r_ij) of the lanes (zero in the masked ones), with V_j = m_j/ρ0_j: the weight of
@@ -49,7 +49,7 @@ pub fn volume_gradient_factor<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Lanes<D>,
-) -> f64x4 {
+) -> F64s {
     (l.load(&p.mass) / l.load(&p.rest_density) * nb.kernel.grad_factor4(l.r)) & l.mask
 }
 
@@ -72,28 +72,26 @@ pub fn viscous_acceleration<const D: usize>(
 ) -> [f64; D] {
     let (rho_i, nu_laminar) = (p.rest_density[i], p.viscosity[i]);
     let nu_i = nu_laminar + eddy.map_or(0.0, |e| e[i]);
-    let d_i = f64x4::splat(face.map_or(f64::INFINITY, |f| f.distance));
+    let d_i = F64s::splat(face.map_or(f64::INFINITY, |f| f.distance));
     let u_i = p.velocity(i);
-    let mut acc = [f64x4::ZERO; D];
+    let mut acc = [F64s::ZERO; D];
     nb.for_each_lanes(i, |l| {
-        let (nu_i, nu_j, du): (f64x4, f64x4, [f64x4; D]) = match l.kind {
+        let (nu_i, nu_j, du): (F64s, F64s, [F64s; D]) = match l.kind {
             Kind::Wall => {
-                let n_r = (0..D).fold(f64x4::ZERO, |s, d| {
-                    l.load(&p.normal[d]).mul_add(l.rij[d], s)
-                });
+                let n_r = (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s));
                 let beta = (n_r / d_i)
-                    .fast_max(f64x4::ONE)
-                    .fast_min(f64x4::splat(MORRIS_BETA_MAX));
-                let nu = f64x4::splat(nu_laminar);
-                (nu, nu, u_i.map(|u| beta * f64x4::splat(u)))
+                    .fast_max(F64s::ONE)
+                    .fast_min(F64s::splat(MORRIS_BETA_MAX));
+                let nu = F64s::splat(nu_laminar);
+                (nu, nu, u_i.map(|u| beta * F64s::splat(u)))
             }
             Kind::Fluid => {
-                let nu_t = eddy.map_or(f64x4::ZERO, |e| l.load(e));
-                let du = std::array::from_fn(|d| f64x4::splat(u_i[d]) - l.load(&p.vel[d]));
-                (f64x4::splat(nu_i), l.load(&p.viscosity) + nu_t, du)
+                let nu_t = eddy.map_or(F64s::ZERO, |e| l.load(e));
+                let du = std::array::from_fn(|d| F64s::splat(u_i[d]) - l.load(&p.vel[d]));
+                (F64s::splat(nu_i), l.load(&p.viscosity) + nu_t, du)
             }
         };
-        let (rho_j, rho_i) = (l.load(&p.rest_density), f64x4::splat(rho_i));
+        let (rho_j, rho_i) = (l.load(&p.rest_density), F64s::splat(rho_i));
         let (_, laplacian_factor) = nb.gradient_and_laplacian_factors4(l.r);
         let c = (l.load(&p.mass) * rho_i.mul_add(nu_i, rho_j * nu_j) / (rho_i * rho_j)
             * laplacian_factor)
@@ -118,15 +116,15 @@ pub fn velocity_gradient<const D: usize>(
     p: &Particles<D>,
     l: &Correction<D>,
     u_i: [f64; D],
-    u: impl Fn(&Lanes<D>) -> [f64x4; D],
+    u: impl Fn(&Lanes<D>) -> [F64s; D],
     i: usize,
 ) -> [[f64; D]; D] {
-    let mut g = [[f64x4::ZERO; D]; D];
+    let mut g = [[F64s::ZERO; D]; D];
     nb.for_each_lanes(i, |lanes| {
         let vf = volume_gradient_factor(nb, p, lanes);
         let u_j = u(lanes);
         for a in 0..D {
-            let du = vf * (u_j[a] - f64x4::splat(u_i[a]));
+            let du = vf * (u_j[a] - F64s::splat(u_i[a]));
             for b in 0..D {
                 g[b][a] = du.mul_add(lanes.rij[b], g[b][a]);
             }
@@ -145,7 +143,7 @@ pub fn velocity_gradient<const D: usize>(
 /// velocity `u_i`: their own for fluid, the free-slip ghost of u_i for walls
 /// (`wall::ghost_velocity`).
 #[inline(always)]
-pub fn fluid_velocity<const D: usize>(p: &Particles<D>, u_i: [f64; D], l: &Lanes<D>) -> [f64x4; D] {
+pub fn fluid_velocity<const D: usize>(p: &Particles<D>, u_i: [f64; D], l: &Lanes<D>) -> [F64s; D] {
     match l.kind {
         Kind::Fluid => std::array::from_fn(|d| l.load(&p.vel[d])),
         Kind::Wall => ghost_velocity(p, l, u_i, u_i),
@@ -178,8 +176,8 @@ pub fn support_moments<const D: usize>(
     p: &Particles<D>,
     i: usize,
 ) -> Moments<D> {
-    let (mut m, mut m_neumann) = ([[f64x4::ZERO; D]; D], [[f64x4::ZERO; D]; D]);
-    let (mut grad_c, mut fluid_neighbours) = ([f64x4::ZERO; D], 0);
+    let (mut m, mut m_neumann) = ([[F64s::ZERO; D]; D], [[F64s::ZERO; D]; D]);
+    let (mut grad_c, mut fluid_neighbours) = ([F64s::ZERO; D], 0);
     nb.for_each_lanes(i, |l| {
         let vf = volume_gradient_factor(nb, p, l);
         // The part of r_ij the pressure of j follows: all of it for fluid, the normal part for
@@ -200,7 +198,7 @@ pub fn support_moments<const D: usize>(
             }
         }
     });
-    let sum = |x: [[f64x4; D]; D]| x.map(|row| row.map(|v| v.reduce_add()));
+    let sum = |x: [[F64s; D]; D]| x.map(|row| row.map(|v| v.reduce_add()));
     Moments {
         m: sum(m),
         m_neumann: sum(m_neumann),
@@ -326,14 +324,14 @@ pub fn fitted_value<const D: usize>(
     values: &[f64],
     i: usize,
 ) -> Option<f64> {
-    let own_fluid = f64x4::splat(p.rest_density[i]);
+    let own_fluid = F64s::splat(p.rest_density[i]);
     // Weighted sums of 1, d = x_j − x_i, φ, d dᵀ and d φ.
-    let (mut w_sum, mut phi_sum) = (f64x4::ZERO, f64x4::ZERO);
-    let mut d_sum = [f64x4::ZERO; D];
-    let mut dd_sum = [[f64x4::ZERO; D]; D];
-    let mut dphi_sum = [f64x4::ZERO; D];
+    let (mut w_sum, mut phi_sum) = (F64s::ZERO, F64s::ZERO);
+    let mut d_sum = [F64s::ZERO; D];
+    let mut dd_sum = [[F64s::ZERO; D]; D];
+    let mut dphi_sum = [F64s::ZERO; D];
     nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-        let same = l.load(&p.rest_density).cmp_eq(own_fluid);
+        let same = l.load(&p.rest_density).simd_eq(own_fluid);
         let w = nb.kernel.w4(l.r) & l.mask & same;
         let phi = l.load(values) & l.mask;
         w_sum += w;
@@ -374,9 +372,9 @@ pub fn gradient<const D: usize>(
     p: &Particles<D>,
     l: &Correction<D>,
     i: usize,
-    difference: impl Fn(&Lanes<D>) -> f64x4,
+    difference: impl Fn(&Lanes<D>) -> F64s,
 ) -> [f64; D] {
-    let mut grad = [f64x4::ZERO; D];
+    let mut grad = [F64s::ZERO; D];
     nb.for_each_lanes(i, |lanes| {
         let c = volume_gradient_factor(nb, p, lanes) * difference(lanes);
         for d in 0..D {

@@ -13,6 +13,7 @@ use crate::faces::Faces;
 use crate::free_surface::Support;
 use crate::grid::CellList;
 use crate::kernel::Quintic;
+use crate::lanes::F64s;
 use crate::linsolve::{BiCgStab, SolveInfo, SolverError, SolverParams};
 use crate::memory::{ArraySize, Holds};
 use crate::multigrid::Multigrid;
@@ -29,7 +30,6 @@ use crate::wall;
 use rayon::iter::Either;
 use rayon::prelude::*;
 use std::time::Instant;
-use wide::f64x4;
 
 /// The constants of a step that come from the scene.
 #[derive(Clone, Copy, Debug)]
@@ -555,9 +555,9 @@ impl<const D: usize> Workspace<D> {
             if !full[i] {
                 return [0.0; 4];
             }
-            let mut nearest = f64x4::splat(f64::INFINITY);
+            let mut nearest = F64s::splat(f64::INFINITY);
             nb.for_each_lanes(i, |l| {
-                nearest = nearest.fast_min(l.mask.blend(l.r, f64x4::splat(f64::INFINITY)));
+                nearest = nearest.fast_min(l.mask.select(l.r, F64s::splat(f64::INFINITY)));
             });
             let nearest = nearest.to_array().into_iter().fold(f64::INFINITY, f64::min);
             let error = (p.density[i] / p.rest_density[i] - 1.0).abs();
@@ -695,9 +695,9 @@ fn pressure_gradient<const D: usize>(
     p_ref: f64,
     i: usize,
 ) -> [f64; D] {
-    let (p_ref, rest_density) = (f64x4::splat(p_ref), f64x4::splat(p.rest_density[i]));
+    let (p_ref, rest_density) = (F64s::splat(p_ref), F64s::splat(p.rest_density[i]));
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
-    let own = f64x4::splat(p.pressure[i]) - p_ref;
+    let own = F64s::splat(p.pressure[i]) - p_ref;
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
         Kind::Fluid => {
             let weight = sph::interface_weight(rest_density, lanes.load(&p.rest_density));

@@ -20,11 +20,11 @@
 //! the wall particles take the wall velocity (zero) plus the fluid particle's own predictor
 //! increment (see `ppe::source`).
 
+use crate::lanes::F64s;
 use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::sph::Neighbours;
 use crate::vector::dot;
-use wide::{f64x4, CmpNe};
 
 /// P_b − P_i = −ρ0_i g·N_b r_ib of the ghost pressures of the wall particles b in lanes `l`
 /// seen from fluid particle i (r_ib = r_i − r_b, the lanes' r_ij).
@@ -34,19 +34,19 @@ pub fn ghost_pressure_difference<const D: usize>(
     gravity: [f64; D],
     i: usize,
     l: &Lanes<D>,
-) -> f64x4 {
+) -> F64s {
     let across = behind_walls(p, l, l.rij);
-    let g_r = (0..D).fold(f64x4::ZERO, |s, d| {
-        f64x4::splat(gravity[d]).mul_add(across[d], s)
+    let g_r = (0..D).fold(F64s::ZERO, |s, d| {
+        F64s::splat(gravity[d]).mul_add(across[d], s)
     });
-    f64x4::splat(-p.rest_density[i]) * g_r
+    F64s::splat(-p.rest_density[i]) * g_r
 }
 
 /// N_b r: the part of r across the walls the wall particles b in lanes `l` lie behind (see
 /// the module doc).
 #[inline(always)]
-pub fn behind_walls<const D: usize>(p: &Particles<D>, l: &Lanes<D>, r: [f64x4; D]) -> [f64x4; D] {
-    std::array::from_fn(|d| r[d] & l.load(&p.normal[d]).cmp_ne(f64x4::ZERO))
+pub fn behind_walls<const D: usize>(p: &Particles<D>, l: &Lanes<D>, r: [F64s; D]) -> [F64s; D] {
+    std::array::from_fn(|d| r[d] & l.load(&p.normal[d]).simd_ne(F64s::ZERO))
 }
 
 /// The velocities the wall particles b in lanes `l` take in the velocity gradients of fluid
@@ -64,9 +64,9 @@ pub fn ghost_velocity<const D: usize>(
     l: &Lanes<D>,
     u_i: [f64; D],
     u_n: [f64; D],
-) -> [f64x4; D] {
-    let across = behind_walls(p, l, u_n.map(f64x4::splat));
-    std::array::from_fn(|d| f64x4::splat(u_i[d]) - across[d])
+) -> [F64s; D] {
+    let across = behind_walls(p, l, u_n.map(F64s::splat));
+    std::array::from_fn(|d| F64s::splat(u_i[d]) - across[d])
 }
 
 /// What the ghost pressures of the walls are made of, borrowed apart from the pressures
@@ -83,17 +83,17 @@ impl<const D: usize> Ghosts<'_, D> {
     /// `fluid_pressure` the pressures of the fluid particles.
     pub fn wall_pressure(&self, nb: &Neighbours<D>, fluid_pressure: &[f64], b: usize) -> f64 {
         // P_b − P_f = −ρ0_f g·N_b r_fb (see the module doc), r_fb = −r_bf; N_b is b's own.
-        let g_across: [f64x4; D] = std::array::from_fn(|d| {
-            f64x4::splat(if self.normal[d][b] != 0.0 {
+        let g_across: [F64s; D] = std::array::from_fn(|d| {
+            F64s::splat(if self.normal[d][b] != 0.0 {
                 self.gravity[d]
             } else {
                 0.0
             })
         });
-        let (mut sum, mut weights) = (f64x4::ZERO, f64x4::ZERO);
+        let (mut sum, mut weights) = (F64s::ZERO, F64s::ZERO);
         nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
             let w = nb.kernel.w4(l.r) & l.mask;
-            let g_r = (0..D).fold(f64x4::ZERO, |s, d| g_across[d].mul_add(l.rij[d], s));
+            let g_r = (0..D).fold(F64s::ZERO, |s, d| g_across[d].mul_add(l.rij[d], s));
             let ghost = l
                 .load(self.rest_density)
                 .mul_add(g_r, l.load(fluid_pressure));

@@ -137,8 +137,8 @@ fn check<const D: usize>(n: i64) {
         let fast = sph::gradient(&nb, &p, &None, i, |l| {
             let x0 = l.load(&p.pos[0]);
             let x1 = l.load(&p.pos[1]);
-            x0 * wide::f64x4::splat(3.0) - x1 * wide::f64x4::splat(2.0)
-                + wide::f64x4::splat(1.0 - phi_i)
+            x0 * isph::lanes::F64s::splat(3.0) - x1 * isph::lanes::F64s::splat(2.0)
+                + isph::lanes::F64s::splat(1.0 - phi_i)
         });
         for d in 0..D {
             assert!(
