@@ -32,20 +32,20 @@ const SLACK: f64 = 1e-9;
 
 /// A slab of cells across axis d as seen from a point: `index` its contribution to the linear
 /// cell index (None outside a bounded axis), `gap2` the squared distance from the point to it,
-/// `image` the point's coordinate along d next to it (moved by a period across a periodic
-/// boundary).
+/// `shift` the periods the point's image next to it is moved by along d (−1, 0 or 1: across
+/// a periodic boundary).
 #[derive(Clone, Copy, Debug)]
 struct Slab {
     index: Option<usize>,
     gap2: f64,
-    image: f64,
+    shift: i8,
 }
 
 impl Slab {
     const OUTSIDE: Self = Self {
         index: None,
         gap2: f64::INFINITY,
-        image: 0.0,
+        shift: 0,
     };
 }
 
@@ -70,6 +70,8 @@ pub struct CellList<const D: usize> {
     cell_start: Vec<u32>,
     /// Cell of each particle in the sorted order.
     sorted_cell: Vec<u32>,
+    /// The runs of cells around each fluid particle (after `sort`).
+    runs: Runs,
 }
 
 /// A particle outside the grid's box (it has left the domain).
@@ -116,6 +118,7 @@ impl<const D: usize> CellList<D> {
             period,
             cell_start: vec![0; KINDS.len() * ncells + 1],
             sorted_cell: Vec::new(),
+            runs: Runs::default(),
         }
     }
 
@@ -237,7 +240,61 @@ impl<const D: usize> CellList<D> {
             self.sorted_cell[k] = cell_of[i];
             next[key(i)] += 1;
         }
+        self.find_runs(pos, order);
         Ok(())
+    }
+
+    /// The runs of cells around every fluid particle (`Runs`), in sorted order: `order` maps
+    /// a sorted index to the index of `pos`. Two passes, each parallel over the particles:
+    /// count the runs, then write them, each block of particles into its own slices.
+    fn find_runs(&mut self, pos: &[Vec<f64>; D], order: &[u32]) {
+        let nf = self.cell_start[self.cell_count()] as usize;
+        let at = |k: usize| -> [f64; D] { std::array::from_fn(|d| pos[d][order[k] as usize]) };
+        let mut runs = std::mem::take(&mut self.runs);
+        runs.end.resize(nf, 0);
+        crate::reduce::fill(&mut runs.end, |k| {
+            let mut n = 0;
+            self.for_each_run(at(k), |_, _, _| n += 1);
+            n
+        });
+        for k in 1..nf {
+            runs.end[k] += runs.end[k - 1];
+        }
+        let start = |k: usize| if k == 0 { 0 } else { runs.end[k - 1] as usize };
+        let total = start(nf);
+        runs.first.resize(total, 0);
+        runs.code.resize(total, 0);
+        let mut blocks = Vec::with_capacity(nf.div_ceil(RUN_BLOCK));
+        let (mut first, mut code) = (&mut runs.first[..], &mut runs.code[..]);
+        for lo in (0..nf).step_by(RUN_BLOCK) {
+            let hi = (lo + RUN_BLOCK).min(nf);
+            let len = start(hi) - start(lo);
+            let (block_first, rest) = std::mem::take(&mut first).split_at_mut(len);
+            first = rest;
+            let (block_code, rest) = std::mem::take(&mut code).split_at_mut(len);
+            code = rest;
+            blocks.push((lo..hi, block_first, block_code));
+        }
+        blocks.into_par_iter().for_each(|(particles, first, code)| {
+            let mut slot = 0;
+            for k in particles {
+                self.for_each_run(at(k), |cell, cells, shift| {
+                    first[slot] = cell as u32;
+                    code[slot] = Runs::encode(cells, shift);
+                    slot += 1;
+                });
+            }
+        });
+        self.runs = runs;
+    }
+
+    /// The runs of cells around the fluid particles, found by `sort`.
+    pub fn runs_arrays(&self) -> [ArraySize; 3] {
+        [
+            ArraySize::of("end of a fluid particle's runs", &self.runs.end).fluid(),
+            ArraySize::sparse("first cell of a run", &self.runs.first),
+            ArraySize::sparse("cells and shift of a run", &self.runs.code),
+        ]
     }
 
     /// Calls `f(range, x′, kind)` with contiguous ranges of the particles of each of `kinds`
@@ -253,8 +310,64 @@ impl<const D: usize> CellList<D> {
         kinds: &[Kind],
         mut f: impl FnMut(Range<usize>, [f64; D], Kind),
     ) {
+        self.for_each_run(x, |first, cells, shift| {
+            self.ranges_of_run(first, cells, self.image(x, shift), kinds, &mut f)
+        });
+    }
+
+    /// `for_each_neighbour_range` around sorted particle i at `x`: a fluid particle's ranges
+    /// come from the runs `sort` found for it (the same ranges in the same order), any other
+    /// particle's from a search of the grid.
+    #[inline(always)]
+    pub fn for_each_range_around(
+        &self,
+        i: usize,
+        x: [f64; D],
+        kinds: &[Kind],
+        mut f: impl FnMut(Range<usize>, [f64; D], Kind),
+    ) {
+        match self.runs.of(i) {
+            Some((first, code)) => {
+                for (&cell, &code) in first.iter().zip(code) {
+                    let (cells, shift) = Runs::decode::<D>(code);
+                    self.ranges_of_run(cell as usize, cells, self.image(x, shift), kinds, &mut f);
+                }
+            }
+            None => self.for_each_neighbour_range(x, kinds, f),
+        }
+    }
+
+    /// The range of each of `kinds` in the `cells` cells from linear index `first` on, where
+    /// it holds particles.
+    #[inline(always)]
+    fn ranges_of_run(
+        &self,
+        first: usize,
+        cells: usize,
+        image: [f64; D],
+        kinds: &[Kind],
+        f: &mut impl FnMut(Range<usize>, [f64; D], Kind),
+    ) {
+        let ncells = self.cell_count();
+        for &kind in kinds {
+            let base = kind as usize * ncells + first;
+            let start = self.cell_start[base] as usize;
+            let end = self.cell_start[base + cells] as usize;
+            if start < end {
+                f(start..end, image, kind);
+            }
+        }
+    }
+
+    /// Calls `f(first, cells, shift)` for every run of cells within reach of `x` that holds
+    /// particles of some kind: `cells` cells from linear index `first` on, one row of cells
+    /// along x cut to the cells within √(R² − d²) of x (d the distance from x to the row), or
+    /// two runs where the row wraps around a periodic x axis; `shift[d]` is the number of
+    /// periods x's image next to the run is moved by along axis d (`image`).
+    #[inline(always)]
+    fn for_each_run(&self, x: [f64; D], mut f: impl FnMut(usize, usize, [i8; D])) {
         // Per axis across x, the rows of cells within reach: the linear index each adds, the
-        // squared distance from x to its slab and x's image next to it.
+        // squared distance from x to its slab and the periods x's image is shifted by.
         let mut across = [[Slab::OUTSIDE; MAX_SPAN]; D];
         for (d, slabs) in across.iter_mut().enumerate().skip(1) {
             let cell = self.cell_along(d, x[d]);
@@ -265,16 +378,22 @@ impl<const D: usize> CellList<D> {
         }
         let ncells = self.cell_count();
         let n = self.dims[0] as i64;
+        let holds_particles = |first: usize, cells: usize| {
+            KINDS.iter().any(|&kind| {
+                let base = kind as usize * ncells + first;
+                self.cell_start[base] < self.cell_start[base + cells]
+            })
+        };
         // The rows, as an odometer over the offsets across x (axis 1 fastest).
         let mut offset = [0usize; D];
         loop {
-            let (mut lin, mut d2, mut image, mut inside) = (0, 0.0, x, true);
+            let (mut lin, mut d2, mut shift, mut inside) = (0, 0.0, [0i8; D], true);
             for d in 1..D {
                 let slab = across[d][offset[d]];
                 inside &= slab.index.is_some();
                 lin += slab.index.unwrap_or(0);
                 d2 += slab.gap2;
-                image[d] = slab.image;
+                shift[d] = slab.shift;
             }
             if inside && d2 < self.support2 {
                 // The cells of the row within √(R² − d²) of x along it: one run of cells, or
@@ -282,29 +401,24 @@ impl<const D: usize> CellList<D> {
                 let along = (self.support2 - d2).sqrt() + SLACK * self.width[0];
                 let from = ((x[0] - along - self.origin[0]) * self.inv_width[0]).floor() as i64;
                 let to = ((x[0] + along - self.origin[0]) * self.inv_width[0]).floor() as i64;
-                let runs = match self.period[0] {
-                    None => [(from.max(0), to.min(n - 1), image), (0, -1, image)],
-                    Some(_) if from < 0 => [
-                        (from + n, n - 1, self.shifted(0, 1.0, image)),
-                        (0, to, image),
-                    ],
-                    Some(_) if to >= n => [
-                        (from, n - 1, image),
-                        (0, to - n, self.shifted(0, -1.0, image)),
-                    ],
-                    Some(_) => [(from, to, image), (0, -1, image)],
+                let wrapped = |s: i8| {
+                    let mut w = shift;
+                    w[0] = s;
+                    w
                 };
-                for (from, to, image) in runs {
+                let runs = match self.period[0] {
+                    None => [(from.max(0), to.min(n - 1), shift), (0, -1, shift)],
+                    Some(_) if from < 0 => [(from + n, n - 1, wrapped(1)), (0, to, shift)],
+                    Some(_) if to >= n => [(from, n - 1, shift), (0, to - n, wrapped(-1))],
+                    Some(_) => [(from, to, shift), (0, -1, shift)],
+                };
+                for (from, to, shift) in runs {
                     if from > to {
                         continue;
                     }
-                    for &kind in kinds {
-                        let base = kind as usize * ncells + lin;
-                        let start = self.cell_start[base + from as usize] as usize;
-                        let end = self.cell_start[base + to as usize + 1] as usize;
-                        if start < end {
-                            f(start..end, image, kind);
-                        }
+                    let (first, cells) = (lin + from as usize, (to - from + 1) as usize);
+                    if holds_particles(first, cells) {
+                        f(first, cells, shift);
                     }
                 }
             }
@@ -322,6 +436,18 @@ impl<const D: usize> CellList<D> {
                 d += 1;
             }
         }
+    }
+
+    /// `x` moved by `shift[d]` periods along each axis d (`for_each_run`).
+    #[inline(always)]
+    fn image(&self, x: [f64; D], shift: [i8; D]) -> [f64; D] {
+        let mut image = x;
+        for (d, &s) in shift.iter().enumerate() {
+            if s != 0 {
+                image = self.shifted(d, s as f64, image);
+            }
+        }
+        image
     }
 
     /// The cell along axis d of coordinate x (of a point inside the grid).
@@ -345,31 +471,28 @@ impl<const D: usize> CellList<D> {
         // A margin, so that rounding in the cell of a particle on a cell's boundary never drops
         // it: candidates too far are masked by the pair test anyway.
         let gap = ((lo - x).max(x - lo - self.width[d]) - SLACK * self.width[d]).max(0.0);
-        let mut image = [x; D];
-        let index = self.wrapped(d, k, &mut image);
+        let (index, shift) = match self.wrapped(d, k) {
+            Some((k, shift)) => (Some(k * stride), shift),
+            None => (None, 0),
+        };
         Slab {
-            index: index.map(|k| k * stride),
+            index,
             gap2: gap * gap,
-            image: image[d],
+            shift,
         }
     }
 
-    /// Cell index `k` along axis `d`, wrapped into the grid along a periodic axis (with `image`
-    /// moved by the period accordingly); None outside the grid along a bounded one.
+    /// Cell index `k` along axis `d`, wrapped into the grid along a periodic axis, with the
+    /// periods a point's image is shifted by accordingly (`shifted`); None outside the grid
+    /// along a bounded one.
     #[inline]
-    fn wrapped(&self, d: usize, k: i64, image: &mut [f64; D]) -> Option<usize> {
+    fn wrapped(&self, d: usize, k: i64) -> Option<(usize, i8)> {
         let n = self.dims[d] as i64;
         match self.period[d] {
-            Some(_) if k < 0 => {
-                *image = self.shifted(d, 1.0, *image);
-                Some((k + n) as usize)
-            }
-            Some(_) if k >= n => {
-                *image = self.shifted(d, -1.0, *image);
-                Some((k - n) as usize)
-            }
+            Some(_) if k < 0 => Some(((k + n) as usize, 1)),
+            Some(_) if k >= n => Some(((k - n) as usize, -1)),
             _ if k < 0 || k >= n => None,
-            _ => Some(k as usize),
+            _ => Some((k as usize, 0)),
         }
     }
 
@@ -381,5 +504,63 @@ impl<const D: usize> CellList<D> {
         let (_, length) = self.period[d].expect("a periodic axis");
         x[d] += sign * length;
         x
+    }
+}
+
+/// Fluid particles per block of `CellList::find_runs`'s parallel pass.
+const RUN_BLOCK: usize = 1024;
+
+/// Bits of a run's code that hold its number of cells; two bits per axis above them hold the
+/// periods the image is shifted by (0: none, 1: +1, 2: −1).
+const RUN_CELLS_BITS: u32 = 10;
+
+/// The runs of cells around every fluid particle, found once per `CellList::sort`: a step's
+/// pair loops visit a fluid particle's neighbours many times (the PPE apply alone thirty times
+/// and more), and searching the grid each time cost about as much as the pair arithmetic of
+/// the apply (docs/performance.md). About 20 runs of 6 bytes per fluid particle in 3D; the
+/// pairs themselves are never stored.
+#[derive(Clone, Debug, Default)]
+struct Runs {
+    /// The runs of sorted fluid particle k are `end[k − 1]..end[k]` (from 0 for k = 0).
+    end: Vec<u32>,
+    /// Linear index of a run's first cell.
+    first: Vec<u32>,
+    /// A run's cells and image shift (`encode`).
+    code: Vec<u16>,
+}
+
+impl Runs {
+    /// The runs of sorted particle i, if it is a fluid particle.
+    #[inline(always)]
+    fn of(&self, i: usize) -> Option<(&[u32], &[u16])> {
+        let hi = *self.end.get(i)? as usize;
+        let lo = if i == 0 { 0 } else { self.end[i - 1] as usize };
+        let run = lo..hi;
+        Some((&self.first[run.clone()], &self.code[run]))
+    }
+
+    fn encode<const D: usize>(cells: usize, shift: [i8; D]) -> u16 {
+        assert!(cells < 1 << RUN_CELLS_BITS, "a run of {cells} cells");
+        let shifts = shift.iter().enumerate().fold(0, |code, (d, &s)| {
+            let bits = match s {
+                0 => 0,
+                1 => 1,
+                _ => 2,
+            };
+            code | bits << (RUN_CELLS_BITS as usize + 2 * d)
+        });
+        cells as u16 | shifts
+    }
+
+    #[inline(always)]
+    fn decode<const D: usize>(code: u16) -> (usize, [i8; D]) {
+        let cells = (code & ((1 << RUN_CELLS_BITS) - 1)) as usize;
+        let shift =
+            std::array::from_fn(|d| match (code >> (RUN_CELLS_BITS as usize + 2 * d)) & 3 {
+                0 => 0,
+                1 => 1,
+                _ => -1,
+            });
+        (cells, shift)
     }
 }

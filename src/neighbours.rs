@@ -13,11 +13,22 @@ use crate::grid::{CellList, KINDS};
 use crate::kernel::Quintic;
 use crate::lanes::{F64s, LANES};
 use crate::particles::Kind;
+use std::ops::Range;
 
 /// η² = 0.0001 h² of Eq. (26)–(27), in units of h².
 const ETA2_IN_H2: f64 = 1.0e-4;
 /// Coordinate of the lanes past the end of the arrays: farther than any support.
 const SENTINEL: f64 = 1.0e30;
+/// 0, 1, … LANES − 1: each lane's offset from the chunk's first candidate.
+const LANE_INDEX: [f64; LANES] = {
+    let mut k = [0.0; LANES];
+    let mut l = 0;
+    while l < LANES {
+        k[l] = l as f64;
+        l += 1;
+    }
+    k
+};
 
 /// `LANES` consecutive candidate neighbours j0 … j0 + LANES − 1 of particle i.
 #[derive(Clone, Copy, Debug)]
@@ -105,41 +116,56 @@ impl<'a, const D: usize> Neighbours<'a, D> {
     /// The pair loop in lanes over the neighbours of `kinds` only.
     #[inline(always)]
     pub fn for_each_lanes_of(&self, i: usize, kinds: &[Kind], mut f: impl FnMut(&Lanes<D>)) {
-        let xi: [f64; D] = std::array::from_fn(|d| self.pos[d][i]);
-        let support2 = F64s::splat(self.support2);
         // `xi` is i's image next to the range (itself but across a periodic boundary).
         self.grid
-            .for_each_neighbour_range(xi, kinds, |range, xi, kind| {
-                let mut j0 = range.start;
-                while j0 < range.end {
-                    let rij: [F64s; D] = std::array::from_fn(|d| {
-                        F64s::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL)
-                    });
-                    let r2 = rij.iter().fold(F64s::ZERO, |s, x| x.mul_add(*x, s));
-                    let mut mask = r2.simd_lt(support2);
-                    let own = i.wrapping_sub(j0);
-                    if own < LANES || j0 + LANES > range.end {
-                        let mut bits = mask.to_array();
-                        for (k, bit) in bits.iter_mut().enumerate() {
-                            if j0 + k == i || j0 + k >= range.end {
-                                *bit = 0.0;
-                            }
-                        }
-                        mask = F64s::from(bits);
-                    }
-                    if mask.any() {
-                        let r = (r2 & mask).sqrt();
-                        f(&Lanes {
-                            j0,
-                            rij,
-                            r,
-                            mask,
-                            kind,
-                        });
-                    }
-                    j0 += LANES;
-                }
+            .for_each_range_around(i, self.position(i), kinds, |range, xi, kind| {
+                self.for_each_lanes_in(i, xi, range, kind, &mut f)
             });
+    }
+
+    /// Position of particle i.
+    #[inline(always)]
+    fn position(&self, i: usize) -> [f64; D] {
+        std::array::from_fn(|d| self.pos[d][i])
+    }
+
+    /// The pair loop in lanes over one range of candidates of one kind, with `xi` the image of
+    /// particle i next to them.
+    #[inline(always)]
+    fn for_each_lanes_in(
+        &self,
+        i: usize,
+        xi: [f64; D],
+        range: Range<usize>,
+        kind: Kind,
+        f: &mut impl FnMut(&Lanes<D>),
+    ) {
+        let support2 = F64s::splat(self.support2);
+        let mut j0 = range.start;
+        while j0 < range.end {
+            let rij: [F64s; D] =
+                std::array::from_fn(|d| F64s::splat(xi[d]) - load(&self.pos[d], j0, SENTINEL));
+            let r2 = rij.iter().fold(F64s::ZERO, |s, x| x.mul_add(*x, s));
+            let mut mask = r2.simd_lt(support2);
+            if i.wrapping_sub(j0) < LANES || j0 + LANES > range.end {
+                // Lane k holds j0 + k: off where it is i or past the range's end.
+                let k = F64s::from(LANE_INDEX);
+                let past_end = F64s::splat((range.end - j0) as f64);
+                let own = F64s::splat(i as f64 - j0 as f64);
+                mask = mask & k.simd_lt(past_end) & k.simd_ne(own);
+            }
+            if mask.any() {
+                let r = (r2 & mask).sqrt();
+                f(&Lanes {
+                    j0,
+                    rij,
+                    r,
+                    mask,
+                    kind,
+                });
+            }
+            j0 += LANES;
+        }
     }
 
     /// The pair loop one neighbour at a time: calls `f(j, r_ij, |r_ij|)` for every particle

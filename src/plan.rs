@@ -99,7 +99,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
     let effects = &scene.effects;
     match stage {
         Stage::CellList => {
-            "counting sort by cell (x fastest), every particle array permuted together".into()
+            "counting sort by cell (x fastest), every particle array permuted together; the runs of cells around each fluid particle, which every pair loop of the step reads instead of searching the grid (about 20 runs of 6 B per fluid particle in 3D, not in the figure)".into()
         }
         Stage::Density => "summation density ρ_i = Σ_j m_j W_ij; walls keep ρ0".into(),
         Stage::FreeSurface => "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".into(),

@@ -296,7 +296,12 @@ impl<const D: usize> Simulation<D> {
             ArraySize::of("sort scratch", &self.scratch),
             self.grid.sorted_cells(),
         ];
-        let mut arrays: Vec<_> = sort.into_iter().map(|a| (Stage::CellList, a)).collect();
+        let runs = self.grid.runs_arrays();
+        let mut arrays: Vec<_> = sort
+            .into_iter()
+            .chain(runs)
+            .map(|a| (Stage::CellList, a))
+            .collect();
         arrays.extend(self.work.arrays());
         arrays
     }

@@ -1,6 +1,6 @@
 //! The cell-list pair loop against a brute-force O(N²) search (its slow, obvious twin).
 
-use isph::grid::CellList;
+use isph::grid::{CellList, KINDS};
 use isph::kernel::{Quintic, SUPPORT_IN_H};
 use isph::particles::{Kind, NewParticle, Particles};
 use isph::sph::Neighbours;
@@ -52,6 +52,16 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
             }
         })
     };
+    // A fluid particle's ranges come from the runs the sort found, a wall particle's from a
+    // search of the grid: the same ranges and images in the same order (the pair loops' sums,
+    // and so the runs' bits, depend on that order).
+    for i in 0..n {
+        let x = std::array::from_fn(|d| p.pos[d][i]);
+        let (mut around, mut searched) = (Vec::new(), Vec::new());
+        grid.for_each_range_around(i, x, &KINDS, |r, image, kind| around.push((r, image, kind)));
+        grid.for_each_neighbour_range(x, &KINDS, |r, image, kind| searched.push((r, image, kind)));
+        assert_eq!(around, searched, "ranges around particle {i}");
+    }
     for i in 0..n {
         let mut fast = Vec::new();
         nb.for_each(i, |j, rij, _| fast.push((j, rij)));
