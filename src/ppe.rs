@@ -15,8 +15,7 @@
 //! first in the sorted order).
 
 use crate::free_surface::Support;
-use crate::lanes::F64s;
-use crate::lanes::LANES;
+use crate::lanes::{F64s, Sum, LANES};
 use crate::linsolve::LinearOperator;
 use crate::multigrid::{stencil_slot, Aggregated};
 use crate::neighbours::Lanes;
@@ -328,7 +327,7 @@ fn laplacian_correction<const D: usize>(
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
-    let mut c = [F64s::ZERO; D];
+    let mut c = [Sum::ZERO; D];
     let scale = F64s::splat(2.0 / p.rest_density[i]);
     let rest_density = F64s::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |lanes| {
@@ -341,10 +340,10 @@ fn laplacian_correction<const D: usize>(
             Kind::Wall => behind_walls(p, lanes, lanes.rij),
         };
         for d in 0..D {
-            c[d] = cl.mul_add(followed[d], c[d]);
+            c[d] = c[d].mul_add(cl, followed[d]);
         }
     });
-    let c = c.map(|x| x.reduce_add());
+    let c = c.map(|x| x.total());
     match l {
         Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[b][a] * c[b]).sum()),
         None => c,
@@ -410,14 +409,14 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// differences.
     fn wall_source(&self, i: usize) -> f64 {
         let (p, row) = (self.p, self.row_constants(i));
-        let mut b = F64s::ZERO;
+        let mut b = Sum::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
             let volume = l.load(&p.mass) / l.load(&p.rest_density);
             let mass = laplacian_mass(p, self.interfaces, row.rest_density, l);
             let w = self.interior_weights(&row, l, mass, volume);
             b += w * ghost_pressure_difference(p, self.ghost_gravity, i, l);
         });
-        b.reduce_add()
+        b.total()
     }
 
     /// (A x)_i: the interior rows couple fluid neighbours only (the walls' pairs are known
@@ -427,11 +426,11 @@ impl<const D: usize> PressureOperator<'_, D> {
         match self.roles[i] {
             Role::Interior => {
                 let (xi, row) = (F64s::splat(x[i]), self.row_constants(i));
-                let mut ax = F64s::ZERO;
+                let mut ax = Sum::ZERO;
                 self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-                    ax = self.fluid_weights(&row, l).mul_add(xi - l.load(x), ax);
+                    ax = ax.mul_add(self.fluid_weights(&row, l), xi - l.load(x));
                 });
-                ax.reduce_add()
+                ax.total()
             }
             Role::Surface | Role::Splash | Role::Reference => x[i],
         }
@@ -450,13 +449,13 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
     fn diagonal(&self, diag: &mut [f64]) {
         let nb = self.nb;
         fill(diag, |i| {
-            let mut d = F64s::ZERO;
+            let mut d = Sum::ZERO;
             match self.roles[i] {
                 Role::Interior => {
                     let row = self.row_constants(i);
                     nb.for_each_lanes_of(i, &[Kind::Fluid], |l| d += self.fluid_weights(&row, l));
                     // A row whose every weight was clipped holds its particle at P = 0.
-                    let d = d.reduce_add();
+                    let d = d.total();
                     if d > 0.0 {
                         d
                     } else {

@@ -19,7 +19,7 @@
 //! Velocity and pressure are then carried to the shifted position by Eq. (9),
 //! φ' = φ + (∇φ)·δr.
 
-use crate::lanes::F64s;
+use crate::lanes::{F64s, Sum};
 use crate::particles::Particles;
 use crate::sph::{volume_gradient_factor, Neighbours};
 
@@ -80,7 +80,7 @@ impl Shifting {
         full_support: bool,
         i: usize,
     ) -> [f64; D] {
-        let mut grad = [F64s::ZERO; D];
+        let mut grad = [Sum::ZERO; D];
         let (inv_w_dx, weight) = (
             F64s::splat(1.0 / self.w_dx),
             F64s::splat(self.clustering_weight),
@@ -90,10 +90,10 @@ impl Shifting {
             let ratio2 = ratio * ratio;
             let c = volume_gradient_factor(nb, p, l) * weight.mul_add(ratio2 * ratio2, F64s::ONE);
             for d in 0..D {
-                grad[d] = c.mul_add(l.rij[d], grad[d]);
+                grad[d] = grad[d].mul_add(c, l.rij[d]);
             }
         });
-        let mut grad_c = grad.map(|g| g.reduce_add());
+        let mut grad_c = grad.map(|g| g.total());
         if !full_support {
             let n = surface_normal;
             let normal_part: f64 = (0..D).map(|d| grad_c[d] * n[d]).sum();

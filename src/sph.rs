@@ -1,7 +1,7 @@
 //! SPH discretisation: the operators of Eq. (20)–(27) written as per-particle sums over the
 //! pair loop of `neighbours`.
 
-use crate::lanes::F64s;
+use crate::lanes::{F64s, Sum};
 use crate::neighbours::Lanes;
 pub use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
@@ -12,12 +12,12 @@ use crate::wall::{behind_walls, ghost_velocity, Face};
 /// fluids each neighbour counts with its volume (Hu & Adams 2006), so that water beside oil
 /// is not taken for expanded (below 0.9 ρ0 it would be spray) nor the oil for compressed.
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
-    let mut rho = F64s::ZERO;
+    let mut rho = Sum::ZERO;
     let rho0_i = F64s::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |l| {
-        rho = ((mass_at_density(p, rho0_i, l) * nb.kernel.w4(l.r)) & l.mask) + rho;
+        rho += (mass_at_density(p, rho0_i, l) * nb.kernel.w4(l.r)) & l.mask;
     });
-    p.mass[i] * nb.kernel.w(0.0) + rho.reduce_add()
+    p.mass[i] * nb.kernel.w(0.0) + rho.total()
 }
 
 /// m_j ρ0_i/ρ0_j = ρ0_i V_j of the lanes: the mass of neighbour j's volume at particle i's rest
@@ -74,7 +74,7 @@ pub fn viscous_acceleration<const D: usize>(
     let nu_i = nu_laminar + eddy.map_or(0.0, |e| e[i]);
     let d_i = F64s::splat(face.map_or(f64::INFINITY, |f| f.distance));
     let u_i = p.velocity(i);
-    let mut acc = [F64s::ZERO; D];
+    let mut acc = [Sum::ZERO; D];
     nb.for_each_lanes(i, |l| {
         let (nu_i, nu_j, du): (F64s, F64s, [F64s; D]) = match l.kind {
             Kind::Wall => {
@@ -97,10 +97,10 @@ pub fn viscous_acceleration<const D: usize>(
             * laplacian_factor)
             & l.mask;
         for d in 0..D {
-            acc[d] = c.mul_add(du[d], acc[d]);
+            acc[d] = acc[d].mul_add(c, du[d]);
         }
     });
-    acc.map(|a| a.reduce_add())
+    acc.map(|a| a.total())
 }
 
 /// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right
@@ -119,18 +119,18 @@ pub fn velocity_gradient<const D: usize>(
     u: impl Fn(&Lanes<D>) -> [F64s; D],
     i: usize,
 ) -> [[f64; D]; D] {
-    let mut g = [[F64s::ZERO; D]; D];
+    let mut g = [[Sum::ZERO; D]; D];
     nb.for_each_lanes(i, |lanes| {
         let vf = volume_gradient_factor(nb, p, lanes);
         let u_j = u(lanes);
         for a in 0..D {
             let du = vf * (u_j[a] - F64s::splat(u_i[a]));
             for b in 0..D {
-                g[b][a] = du.mul_add(lanes.rij[b], g[b][a]);
+                g[b][a] = g[b][a].mul_add(du, lanes.rij[b]);
             }
         }
     });
-    let g = g.map(|row| row.map(|x| x.reduce_add()));
+    let g = g.map(|row| row.map(|x| x.total()));
     std::array::from_fn(|b| {
         std::array::from_fn(|a| match l {
             Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
@@ -176,8 +176,8 @@ pub fn support_moments<const D: usize>(
     p: &Particles<D>,
     i: usize,
 ) -> Moments<D> {
-    let (mut m, mut m_neumann) = ([[F64s::ZERO; D]; D], [[F64s::ZERO; D]; D]);
-    let (mut grad_c, mut fluid_neighbours) = ([F64s::ZERO; D], 0);
+    let (mut m, mut m_neumann) = ([[Sum::ZERO; D]; D], [[Sum::ZERO; D]; D]);
+    let (mut grad_c, mut fluid_neighbours) = ([Sum::ZERO; D], 0);
     nb.for_each_lanes(i, |l| {
         let vf = volume_gradient_factor(nb, p, l);
         // The part of r_ij the pressure of j follows: all of it for fluid, the normal part for
@@ -193,16 +193,16 @@ pub fn support_moments<const D: usize>(
             let v = vf * l.rij[a];
             grad_c[a] += v;
             for b in 0..D {
-                m[a][b] = (-v).mul_add(l.rij[b], m[a][b]);
-                m_neumann[a][b] = (-v).mul_add(followed[b], m_neumann[a][b]);
+                m[a][b] = m[a][b].mul_add(-v, l.rij[b]);
+                m_neumann[a][b] = m_neumann[a][b].mul_add(-v, followed[b]);
             }
         }
     });
-    let sum = |x: [[F64s; D]; D]| x.map(|row| row.map(|v| v.reduce_add()));
+    let sum = |x: [[Sum; D]; D]| x.map(|row| row.map(|v| v.total()));
     Moments {
         m: sum(m),
         m_neumann: sum(m_neumann),
-        grad_c: grad_c.map(|v| v.reduce_add()),
+        grad_c: grad_c.map(|v| v.total()),
         fluid_neighbours,
     }
 }
@@ -326,33 +326,32 @@ pub fn fitted_value<const D: usize>(
 ) -> Option<f64> {
     let own_fluid = F64s::splat(p.rest_density[i]);
     // Weighted sums of 1, d = x_j − x_i, φ, d dᵀ and d φ.
-    let (mut w_sum, mut phi_sum) = (F64s::ZERO, F64s::ZERO);
-    let mut d_sum = [F64s::ZERO; D];
-    let mut dd_sum = [[F64s::ZERO; D]; D];
-    let mut dphi_sum = [F64s::ZERO; D];
+    let (mut w_sum, mut phi_sum) = (Sum::ZERO, Sum::ZERO);
+    let mut d_sum = [Sum::ZERO; D];
+    let mut dd_sum = [[Sum::ZERO; D]; D];
+    let mut dphi_sum = [Sum::ZERO; D];
     nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
         let same = l.load(&p.rest_density).simd_eq(own_fluid);
         let w = nb.kernel.w4(l.r) & l.mask & same;
         let phi = l.load(values) & l.mask;
         w_sum += w;
-        phi_sum = w.mul_add(phi, phi_sum);
+        phi_sum = phi_sum.mul_add(w, phi);
         for a in 0..D {
             let wd = -w * l.rij[a];
             d_sum[a] += wd;
-            dphi_sum[a] = wd.mul_add(phi, dphi_sum[a]);
+            dphi_sum[a] = dphi_sum[a].mul_add(wd, phi);
             for b in a..D {
-                dd_sum[a][b] = wd.mul_add(-l.rij[b], dd_sum[a][b]);
+                dd_sum[a][b] = dd_sum[a][b].mul_add(wd, -l.rij[b]);
             }
         }
     });
-    let w = w_sum.reduce_add();
-    let d_mean = d_sum.map(|x| x.reduce_add() / w);
-    let phi_mean = phi_sum.reduce_add() / w;
+    let w = w_sum.total();
+    let d_mean = d_sum.map(|x| x.total() / w);
+    let phi_mean = phi_sum.total() / w;
     let covariance: [[f64; D]; D] = std::array::from_fn(|a| {
-        std::array::from_fn(|b| dd_sum[a.min(b)][a.max(b)].reduce_add() - w * d_mean[a] * d_mean[b])
+        std::array::from_fn(|b| dd_sum[a.min(b)][a.max(b)].total() - w * d_mean[a] * d_mean[b])
     });
-    let cross: [f64; D] =
-        std::array::from_fn(|a| dphi_sum[a].reduce_add() - w * d_mean[a] * phi_mean);
+    let cross: [f64; D] = std::array::from_fn(|a| dphi_sum[a].total() - w * d_mean[a] * phi_mean);
     let spread = (0..D).map(|a| covariance[a][a]).sum::<f64>() / D as f64;
     let (inverse, det) = invert(covariance)?;
     let spans = w > 0.0 && det > MIN_FIT_ISOTROPY * spread.powi(D as i32);
@@ -374,14 +373,14 @@ pub fn gradient<const D: usize>(
     i: usize,
     difference: impl Fn(&Lanes<D>) -> F64s,
 ) -> [f64; D] {
-    let mut grad = [F64s::ZERO; D];
+    let mut grad = [Sum::ZERO; D];
     nb.for_each_lanes(i, |lanes| {
         let c = volume_gradient_factor(nb, p, lanes) * difference(lanes);
         for d in 0..D {
-            grad[d] = c.mul_add(lanes.rij[d], grad[d]);
+            grad[d] = grad[d].mul_add(c, lanes.rij[d]);
         }
     });
-    apply_correction(l, grad.map(|g| g.reduce_add()))
+    apply_correction(l, grad.map(|g| g.total()))
 }
 
 /// Coefficient a_ij ≥ 0 of the negative Laplacian of Eq. (27):

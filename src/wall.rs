@@ -20,7 +20,7 @@
 //! the wall particles take the wall velocity (zero) plus the fluid particle's own predictor
 //! increment (see `ppe::source`).
 
-use crate::lanes::F64s;
+use crate::lanes::{F64s, Sum};
 use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::sph::Neighbours;
@@ -90,17 +90,17 @@ impl<const D: usize> Ghosts<'_, D> {
                 0.0
             })
         });
-        let (mut sum, mut weights) = (F64s::ZERO, F64s::ZERO);
+        let (mut sum, mut weights) = (Sum::ZERO, Sum::ZERO);
         nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
             let w = nb.kernel.w4(l.r) & l.mask;
             let g_r = (0..D).fold(F64s::ZERO, |s, d| g_across[d].mul_add(l.rij[d], s));
             let ghost = l
                 .load(self.rest_density)
                 .mul_add(g_r, l.load(fluid_pressure));
-            sum = w.mul_add(ghost, sum);
+            sum = sum.mul_add(w, ghost);
             weights += w;
         });
-        let (sum, weights) = (sum.reduce_add(), weights.reduce_add());
+        let (sum, weights) = (sum.total(), weights.total());
         if weights > 0.0 {
             sum / weights
         } else {

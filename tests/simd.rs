@@ -166,3 +166,33 @@ fn simd_operators_match_their_scalar_twins() {
     check::<2>(16);
     check::<3>(9);
 }
+
+/// `lanes::Sum` adds the lanes of every chunk four at a time in index order: the sums of a
+/// build of any width have the bits of a build of four lanes (checked here against four-lane
+/// sums written out, over chunks of pseudo-random terms).
+#[test]
+fn lane_sums_have_the_bits_of_four_lanes() {
+    use isph::lanes::{F64s, Sum, LANES};
+    let mut seed = 7;
+    let terms: Vec<(f64, f64)> = (0..64 * LANES)
+        .map(|_| (lcg(&mut seed) - 0.5, 1e3 * lcg(&mut seed)))
+        .collect();
+    let (mut sum, mut fused) = (Sum::ZERO, Sum::ZERO);
+    for chunk in terms.chunks(LANES) {
+        let a = F64s::from(std::array::from_fn::<f64, LANES, _>(|k| chunk[k].0));
+        let b = F64s::from(std::array::from_fn::<f64, LANES, _>(|k| chunk[k].1));
+        sum += a;
+        fused = fused.mul_add(a, b);
+    }
+    let (mut lanes_sum, mut lanes_fused) = ([0.0f64; 4], [0.0f64; 4]);
+    for four in terms.chunks(4) {
+        for k in 0..4 {
+            lanes_sum[k] += four[k].0;
+            lanes_fused[k] = four[k].0.mul_add(four[k].1, lanes_fused[k]);
+        }
+    }
+    // f64x4::reduce_add's order.
+    let total = |l: [f64; 4]| wide::f64x4::from(l).reduce_add();
+    assert_eq!(sum.total().to_bits(), total(lanes_sum).to_bits());
+    assert_eq!(fused.total().to_bits(), total(lanes_fused).to_bits());
+}
