@@ -258,7 +258,8 @@ impl<const D: usize> CellList<D> {
             n
         });
         for k in 1..nf {
-            runs.end[k] += runs.end[k - 1];
+            runs.end[k] = (runs.end[k].checked_add(runs.end[k - 1]))
+                .expect("fewer than 2^32 runs of cells around the fluid particles");
         }
         let start = |k: usize| if k == 0 { 0 } else { runs.end[k - 1] as usize };
         let total = start(nf);
@@ -326,6 +327,10 @@ impl<const D: usize> CellList<D> {
         kinds: &[Kind],
         mut f: impl FnMut(Range<usize>, [f64; D], Kind),
     ) {
+        // The runs hold for the positions of the last sort.
+        debug_assert!(
+            self.runs.of(i).is_none() || self.cell_of(x) == Some(self.sorted_cell[i] as usize)
+        );
         match self.runs.of(i) {
             Some((first, code)) => {
                 for (&cell, &code) in first.iter().zip(code) {

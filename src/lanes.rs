@@ -4,9 +4,9 @@
 //! machine four in one ymm register (eight there would be two ymm registers per operation, and
 //! measured 15% slower than four: docs/performance.md).
 //!
-//! The width changes the order in which a row's pairs are summed, so runs on builds of
-//! different widths agree to round-off, not bit for bit; one build gives the same bits at any
-//! thread count.
+//! The width does not change the results: the pair loops sum into a `Sum`, which adds a
+//! chunk's lanes four at a time in index order, so builds of either width give the same bits
+//! (with FMA, which every AVX-512 CPU has), and one build the same bits at any thread count.
 
 #[cfg(target_feature = "avx512f")]
 mod width {
