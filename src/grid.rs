@@ -244,9 +244,10 @@ impl<const D: usize> CellList<D> {
         Ok(())
     }
 
-    /// The runs of cells around every fluid particle (`Runs`), in sorted order: `order` maps
-    /// a sorted index to the index of `pos`. Two passes, each parallel over the particles:
-    /// count the runs, then write them, each block of particles into its own slices.
+    /// The runs of cells around every fluid particle that hold particles (`Runs`), in sorted
+    /// order: `order` maps a sorted index to the index of `pos`. Two passes, each parallel
+    /// over the particles: count the runs, then write them, each block of particles into its
+    /// own slices.
     fn find_runs(&mut self, pos: &[Vec<f64>; D], order: &[u32]) {
         let nf = self.cell_start[self.cell_count()] as usize;
         let at = |k: usize| -> [f64; D] { std::array::from_fn(|d| pos[d][order[k] as usize]) };
@@ -254,7 +255,9 @@ impl<const D: usize> CellList<D> {
         runs.end.resize(nf, 0);
         crate::reduce::fill(&mut runs.end, |k| {
             let mut n = 0;
-            self.for_each_run(at(k), |_, _, _| n += 1);
+            self.for_each_run(at(k), |first, cells, _| {
+                n += self.holds_particles(first, cells) as u32
+            });
             n
         });
         for k in 1..nf {
@@ -280,13 +283,24 @@ impl<const D: usize> CellList<D> {
             let mut slot = 0;
             for k in particles {
                 self.for_each_run(at(k), |cell, cells, shift| {
-                    first[slot] = cell as u32;
-                    code[slot] = Runs::encode(cells, shift);
-                    slot += 1;
+                    if self.holds_particles(cell, cells) {
+                        first[slot] = cell as u32;
+                        code[slot] = Runs::encode(cells, shift);
+                        slot += 1;
+                    }
                 });
             }
         });
         self.runs = runs;
+    }
+
+    /// Whether the `cells` cells from linear index `first` on hold particles of some kind.
+    fn holds_particles(&self, first: usize, cells: usize) -> bool {
+        let ncells = self.cell_count();
+        KINDS.iter().any(|&kind| {
+            let base = kind as usize * ncells + first;
+            self.cell_start[base] < self.cell_start[base + cells]
+        })
     }
 
     /// The runs of cells around the fluid particles, found by `sort`.
@@ -364,8 +378,8 @@ impl<const D: usize> CellList<D> {
         }
     }
 
-    /// Calls `f(first, cells, shift)` for every run of cells within reach of `x` that holds
-    /// particles of some kind: `cells` cells from linear index `first` on, one row of cells
+    /// Calls `f(first, cells, shift)` for every run of cells within reach of `x`: `cells`
+    /// cells from linear index `first` on, one row of cells
     /// along x cut to the cells within √(R² − d²) of x (d the distance from x to the row), or
     /// two runs where the row wraps around a periodic x axis; `shift[d]` is the number of
     /// periods x's image next to the run is moved by along axis d (`image`).
@@ -381,14 +395,7 @@ impl<const D: usize> CellList<D> {
                 *slab = self.slab(d, cell + o as i64 - self.reach[d], x[d], stride);
             }
         }
-        let ncells = self.cell_count();
         let n = self.dims[0] as i64;
-        let holds_particles = |first: usize, cells: usize| {
-            KINDS.iter().any(|&kind| {
-                let base = kind as usize * ncells + first;
-                self.cell_start[base] < self.cell_start[base + cells]
-            })
-        };
         // The rows, as an odometer over the offsets across x (axis 1 fastest).
         let mut offset = [0usize; D];
         loop {
@@ -421,10 +428,7 @@ impl<const D: usize> CellList<D> {
                     if from > to {
                         continue;
                     }
-                    let (first, cells) = (lin + from as usize, (to - from + 1) as usize);
-                    if holds_particles(first, cells) {
-                        f(first, cells, shift);
-                    }
+                    f(lin + from as usize, (to - from + 1) as usize, shift);
                 }
             }
             // Next row.
