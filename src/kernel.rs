@@ -67,8 +67,8 @@ impl<const D: usize> Quintic<D> {
 
     /// W(r) in lanes.
     #[inline(always)]
-    pub fn w4(&self, r: F64s) -> F64s {
-        let [a, b, c] = self.spline_terms4(r);
+    pub fn w_lanes(&self, r: F64s) -> F64s {
+        let [a, b, c] = self.spline_terms_lanes(r);
         let p5 = |x: F64s| (x * x) * (x * x) * x;
         F64s::splat(self.norm)
             * F64s::splat(15.0).mul_add(p5(c), F64s::splat(-6.0).mul_add(p5(b), p5(a)))
@@ -76,15 +76,15 @@ impl<const D: usize> Quintic<D> {
 
     /// F(r) = W'(r)/r in lanes (W''(0) where r = 0, as `grad_factor`).
     #[inline(always)]
-    pub fn grad_factor4(&self, r: F64s) -> F64s {
-        let (dw_dr, at_zero) = self.derivative4(r);
+    pub fn grad_factor_lanes(&self, r: F64s) -> F64s {
+        let (dw_dr, at_zero) = self.derivative_lanes(r);
         at_zero.select(F64s::splat(self.grad_factor(0.0)), dw_dr / r)
     }
 
     /// W'(r) in lanes, and the mask of the lanes with r = 0.
     #[inline(always)]
-    pub fn derivative4(&self, r: F64s) -> (F64s, F64s) {
-        let [a, b, c] = self.spline_terms4(r);
+    pub fn derivative_lanes(&self, r: F64s) -> (F64s, F64s) {
+        let [a, b, c] = self.spline_terms_lanes(r);
         let p4 = |x: F64s| (x * x) * (x * x);
         let dw_dq = F64s::splat(-5.0)
             * F64s::splat(15.0).mul_add(p4(c), F64s::splat(-6.0).mul_add(p4(b), p4(a)));
@@ -96,7 +96,7 @@ impl<const D: usize> Quintic<D> {
 
     /// (3 − q)₊, (2 − q)₊, (1 − q)₊ with q = r/h.
     #[inline(always)]
-    fn spline_terms4(&self, r: F64s) -> [F64s; 3] {
+    fn spline_terms_lanes(&self, r: F64s) -> [F64s; 3] {
         let q = r * F64s::splat(self.inv_h);
         [3.0, 2.0, 1.0].map(|k| (F64s::splat(k) - q).fast_max(F64s::ZERO))
     }

@@ -197,8 +197,8 @@ impl<'a, const D: usize> Neighbours<'a, D> {
 
     /// F(r) = W'(r)/r and r² F/(r² + η²) (`laplacian_factor`) in lanes, with one division.
     #[inline(always)]
-    pub fn gradient_and_laplacian_factors4(&self, r: F64s) -> (F64s, F64s) {
-        let (dw_dr, at_zero) = self.kernel.derivative4(r);
+    pub fn gradient_and_laplacian_factors_lanes(&self, r: F64s) -> (F64s, F64s) {
+        let (dw_dr, at_zero) = self.kernel.derivative_lanes(r);
         let r2 = r * r;
         let r2_eta2 = r2 + F64s::splat(self.eta2);
         let inv = F64s::ONE / (r * r2_eta2).fast_max(F64s::splat(f64::MIN_POSITIVE));

@@ -331,7 +331,7 @@ fn laplacian_correction<const D: usize>(
     let scale = F64s::splat(2.0 / p.rest_density[i]);
     let rest_density = F64s::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |lanes| {
-        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors4(lanes.r);
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(lanes.r);
         // −a_ij of Eq. (27) (`sph::laplacian_coefficient`).
         let mass = laplacian_mass(p, interfaces, rest_density, lanes);
         let cl = (scale * mass * laplacian_factor) & lanes.mask;
@@ -388,7 +388,7 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij = −(2 m̃_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
     #[inline(always)]
     fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, mass: F64s, volume: F64s) -> F64s {
-        let (f, laplacian_factor) = self.nb.gradient_and_laplacian_factors4(l.r);
+        let (f, laplacian_factor) = self.nb.gradient_and_laplacian_factors_lanes(l.r);
         let laplacian = row.scale * mass * laplacian_factor;
         let c_r = (0..D).fold(F64s::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
         let correction = volume * f * c_r;

@@ -86,7 +86,7 @@ impl Shifting {
             F64s::splat(self.clustering_weight),
         );
         nb.for_each_lanes(i, |l| {
-            let ratio = nb.kernel.w4(l.r) * inv_w_dx;
+            let ratio = nb.kernel.w_lanes(l.r) * inv_w_dx;
             let ratio2 = ratio * ratio;
             let c = volume_gradient_factor(nb, p, l) * weight.mul_add(ratio2 * ratio2, F64s::ONE);
             for d in 0..D {

@@ -15,7 +15,7 @@ pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -
     let mut rho = Sum::ZERO;
     let rho0_i = F64s::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |l| {
-        rho += (mass_at_density(p, rho0_i, l) * nb.kernel.w4(l.r)) & l.mask;
+        rho += (mass_at_density(p, rho0_i, l) * nb.kernel.w_lanes(l.r)) & l.mask;
     });
     p.mass[i] * nb.kernel.w(0.0) + rho.total()
 }
@@ -50,7 +50,7 @@ pub fn volume_gradient_factor<const D: usize>(
     p: &Particles<D>,
     l: &Lanes<D>,
 ) -> F64s {
-    (l.load(&p.mass) / l.load(&p.rest_density) * nb.kernel.grad_factor4(l.r)) & l.mask
+    (l.load(&p.mass) / l.load(&p.rest_density) * nb.kernel.grad_factor_lanes(l.r)) & l.mask
 }
 
 /// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, ν_t the eddy viscosity
@@ -92,7 +92,7 @@ pub fn viscous_acceleration<const D: usize>(
             }
         };
         let (rho_j, rho_i) = (l.load(&p.rest_density), F64s::splat(rho_i));
-        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors4(l.r);
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(l.r);
         let c = (l.load(&p.mass) * rho_i.mul_add(nu_i, rho_j * nu_j) / (rho_i * rho_j)
             * laplacian_factor)
             & l.mask;
@@ -332,7 +332,7 @@ pub fn fitted_value<const D: usize>(
     let mut dphi_sum = [Sum::ZERO; D];
     nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
         let same = l.load(&p.rest_density).simd_eq(own_fluid);
-        let w = nb.kernel.w4(l.r) & l.mask & same;
+        let w = nb.kernel.w_lanes(l.r) & l.mask & same;
         let phi = l.load(values) & l.mask;
         w_sum += w;
         phi_sum = phi_sum.mul_add(w, phi);

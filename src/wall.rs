@@ -92,7 +92,7 @@ impl<const D: usize> Ghosts<'_, D> {
         });
         let (mut sum, mut weights) = (Sum::ZERO, Sum::ZERO);
         nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
-            let w = nb.kernel.w4(l.r) & l.mask;
+            let w = nb.kernel.w_lanes(l.r) & l.mask;
             let g_r = (0..D).fold(F64s::ZERO, |s, d| g_across[d].mul_add(l.rij[d], s));
             let ghost = l
                 .load(self.rest_density)
