@@ -26,6 +26,9 @@ pub const fn subdivision(d: usize) -> usize {
 
 /// Rows of cells across x within reach, at most (reach ≤ 2 along axes subdivided in two).
 const MAX_SPAN: usize = 5;
+/// Runs of cells around a point at most: one row along x per cell within reach across it
+/// (MAX_SPAN² in 3D), two runs where a row wraps around a periodic x axis.
+const MAX_RUNS: usize = 2 * MAX_SPAN * MAX_SPAN;
 
 /// Distances are widened by this fraction of a cell's width in the neighbour search.
 const SLACK: f64 = 1e-9;
@@ -332,7 +335,10 @@ impl<const D: usize> CellList<D> {
 
     /// `for_each_neighbour_range` around sorted particle i at `x`: a fluid particle's ranges
     /// come from the runs `sort` found for it (the same ranges in the same order), any other
-    /// particle's from a search of the grid.
+    /// particle's from a search of the grid into a buffer on the stack. Either way `f` is
+    /// called from one place, so that it is inlined into the loop over the runs and the pair
+    /// loops keep their sums in registers across the ranges (called from two places, the
+    /// compiler kept `f` out of line: a call, and the sums through memory, for every range).
     #[inline(always)]
     pub fn for_each_range_around(
         &self,
@@ -345,14 +351,22 @@ impl<const D: usize> CellList<D> {
         debug_assert!(
             self.runs.of(i).is_none() || self.cell_of(x) == Some(self.sorted_cell[i] as usize)
         );
-        match self.runs.of(i) {
-            Some((first, code)) => {
-                for (&cell, &code) in first.iter().zip(code) {
-                    let (cells, shift) = Runs::decode::<D>(code);
-                    self.ranges_of_run(cell as usize, cells, self.image(x, shift), kinds, &mut f);
-                }
+        let (mut found_first, mut found_code) = ([0u32; MAX_RUNS], [0u16; MAX_RUNS]);
+        let (first, code) = match self.runs.of(i) {
+            Some(runs) => runs,
+            None => {
+                let mut n = 0;
+                self.for_each_run(x, |cell, cells, shift| {
+                    found_first[n] = cell as u32;
+                    found_code[n] = Runs::encode(cells, shift);
+                    n += 1;
+                });
+                (&found_first[..n], &found_code[..n])
             }
-            None => self.for_each_neighbour_range(x, kinds, f),
+        };
+        for (&cell, &code) in first.iter().zip(code) {
+            let (cells, shift) = Runs::decode::<D>(code);
+            self.ranges_of_run(cell as usize, cells, self.image(x, shift), kinds, &mut f);
         }
     }
 
@@ -548,6 +562,7 @@ impl Runs {
         Some((&self.first[run.clone()], &self.code[run]))
     }
 
+    #[inline(always)]
     fn encode<const D: usize>(cells: usize, shift: [i8; D]) -> u16 {
         assert!(cells < 1 << RUN_CELLS_BITS, "a run of {cells} cells");
         let shifts = shift.iter().enumerate().fold(0, |code, (d, &s)| {
