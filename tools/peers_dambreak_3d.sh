@@ -12,7 +12,9 @@
 #   SOLVERS  SPlisHSPlasH's implicit pressure solvers to run, each in turn: DFSPH, IISPH
 # Environment: ISPH (isph binary, default target/release/isph, built if missing), WORK (scratch
 # directory, default /tmp/isph_peers_dambreak_3d), SPLASH_VENV (default /tmp/peers_splash_venv),
-# MAXERROR (SPlisHSPlasH's density tolerance in percent; default its own, 0.01).
+# MAXERROR (SPlisHSPlasH's density tolerance in percent; default its own, 0.01), ISPH_SOLVER
+# (keys of the scene's [solver] section for isph, e.g. "cfl = 0.4; tolerance = 1e-4", to compare
+# at another time step or PPE tolerance; default none: the scene's defaults).
 set -euo pipefail
 SPACING=${1:-0.02}
 UNTIL=${2:-0.3}
@@ -44,6 +46,10 @@ sed -e "s/^spacing = [0-9.e-]*/spacing = $SPACING/" \
     -e "s/^end_time = [0-9.e-]*/end_time = $UNTIL/" \
     -e "s/^output_interval = [0-9.e-]*/output_interval = $UNTIL/" \
     "$ROOT/scenes/dam_break_3d.toml" > "$SCENE"
+if [ -n "${ISPH_SOLVER:-}" ]; then
+  printf '\n[solver]\n%s\n' "$(echo "$ISPH_SOLVER" | tr ';' '\n' | sed 's/^ *//')" >> "$SCENE"
+  echo "isph [solver]: $ISPH_SOLVER"
+fi
 for key in "spacing = $SPACING" "end_time = $UNTIL" "output_interval = $UNTIL"; do
   grep -q "^$key" "$SCENE" || { echo "error: could not set \`$key\` in $SCENE (has scenes/dam_break_3d.toml changed?)" >&2; exit 1; }
 done
