@@ -23,7 +23,7 @@
 //! The preconditioner is a fixed linear map of the residual, as BiCGSTAB needs, and every sum
 //! runs in a fixed order: the result does not depend on the thread count.
 
-use crate::linsolve::{inverse_diagonal, LinearOperator, Preconditioner, SolverError};
+use crate::linsolve::{LinearOperator, Preconditioner, SolverError};
 use crate::memory::ArraySize;
 use crate::reduce::fill;
 use rayon::prelude::*;
@@ -49,8 +49,9 @@ pub trait Aggregated<const D: usize>: LinearOperator {
     fn aggregate(&self, i: usize) -> Option<usize>;
     /// Adds row i of A into the stencil row of its cell: `row[slot] += a_ij` for each entry,
     /// with `slot` the position of j's cell in the 3^D stencil around i's cell (see
-    /// [`stencil_slot`]).
-    fn add_coarse_row(&self, i: usize, row: &mut [f64]);
+    /// [`stencil_slot`]). Returns a_ii with the bits `LinearOperator::diagonal` gives it: the
+    /// build takes the fine diagonal from here instead of from a pass of its own.
+    fn add_coarse_row(&self, i: usize, row: &mut [f64]) -> f64;
 }
 
 /// Index in the 3^D stencil of the cell offset (o_0, …, o_{D−1}) ∈ {−1, 0, 1}^D, x fastest.
@@ -233,7 +234,6 @@ impl<const D: usize> Multigrid<D> {
     /// Builds the hierarchy for operator `a`.
     pub fn build(&mut self, a: &impl Aggregated<D>) -> Result<(), SolverError> {
         let n = a.len();
-        inverse_diagonal(a, &mut self.fine_inv_diag)?;
         self.fine_cell.resize(n, 0);
         fill(&mut self.fine_cell, |i| {
             a.aggregate(i).map_or(u32::MAX, |c| c as u32)
@@ -248,15 +248,23 @@ impl<const D: usize> Multigrid<D> {
                 members[c as usize].push(i);
             }
         }
-        first
+        let diagonals: Vec<Vec<f64>> = first
             .stencil
             .par_chunks_mut(w)
             .zip(&members)
-            .for_each(|(row, members)| {
-                for &i in members {
-                    a.add_coarse_row(i, row);
+            .map(|(row, members)| members.iter().map(|&i| a.add_coarse_row(i, row)).collect())
+            .collect();
+        // The unknowns outside every aggregate are rows of the identity.
+        self.fine_inv_diag.clear();
+        self.fine_inv_diag.resize(n, 1.0);
+        for (members, diagonals) in members.iter().zip(&diagonals) {
+            for (&i, &d) in members.iter().zip(diagonals) {
+                if d == 0.0 {
+                    return Err(SolverError::ZeroDiagonal { row: i });
                 }
-            });
+                self.fine_inv_diag[i] = 1.0 / d;
+            }
+        }
         first.finish();
         self.levels.clear();
         self.levels.push(first);

@@ -447,23 +447,15 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
     }
 
     fn diagonal(&self, diag: &mut [f64]) {
-        let nb = self.nb;
-        fill(diag, |i| {
-            let mut d = Sum::ZERO;
-            match self.roles[i] {
-                Role::Interior => {
-                    let row = self.row_constants(i);
-                    nb.for_each_lanes_of(i, &[Kind::Fluid], |l| d += self.fluid_weights(&row, l));
-                    // A row whose every weight was clipped holds its particle at P = 0.
-                    let d = d.total();
-                    if d > 0.0 {
-                        d
-                    } else {
-                        1.0
-                    }
-                }
-                Role::Surface | Role::Splash | Role::Reference => 1.0,
+        fill(diag, |i| match self.roles[i] {
+            Role::Interior => {
+                let row = self.row_constants(i);
+                let mut d = Sum::ZERO;
+                self.nb
+                    .for_each_lanes_of(i, &[Kind::Fluid], |l| d += self.fluid_weights(&row, l));
+                interior_diagonal(d)
             }
+            Role::Surface | Role::Splash | Role::Reference => 1.0,
         })
     }
 }
@@ -480,18 +472,18 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
         }
     }
 
-    fn add_coarse_row(&self, i: usize, row: &mut [f64]) {
+    fn add_coarse_row(&self, i: usize, row: &mut [f64]) -> f64 {
         // Interior rows: a_ii = Σ w, a_ij = −w; the other rows are not aggregated.
-        if self.roles[i] != Role::Interior {
-            return;
-        }
+        debug_assert_eq!(self.roles[i], Role::Interior, "row {i} is not aggregated");
         let (grid, p) = (self.nb.grid(), self.p);
         let block =
             |j: usize| -> [i64; D] { std::array::from_fn(|d| grid.block_along(d, p.pos[d][j])) };
         let (centre, block_i) = (stencil_slot([0; D]), block(i));
         let constants = self.row_constants(i);
+        let mut diagonal = Sum::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
             let w = self.fluid_weights(&constants, l);
+            diagonal += w;
             for (k, w) in w.to_array().into_iter().enumerate() {
                 if w == 0.0 {
                     continue;
@@ -508,5 +500,17 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
                 }
             }
         });
+        interior_diagonal(diagonal)
+    }
+}
+
+/// a_ii of an interior row from the sum of its weights (`PressureOperator::interior_weights`):
+/// a row whose every weight was clipped holds its particle at P = 0.
+fn interior_diagonal(weights: Sum) -> f64 {
+    let d = weights.total();
+    if d > 0.0 {
+        d
+    } else {
+        1.0
     }
 }
