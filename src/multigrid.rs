@@ -216,6 +216,42 @@ pub struct Multigrid<const D: usize> {
     levels: Vec<Level<D>>,
 }
 
+/// The unknowns of each cell of level 1, in index order: a counting sort of the unknowns by
+/// cell (no list per cell).
+struct Members {
+    /// The unknowns of cell c are `unknowns[start[c]..start[c + 1]]`.
+    start: Vec<u32>,
+    unknowns: Vec<u32>,
+}
+
+impl Members {
+    /// The members of the `cells` cells, with `cell_of[i]` the cell of unknown i (`u32::MAX`:
+    /// none).
+    fn of(cell_of: &[u32], cells: usize) -> Self {
+        let mut start = vec![0u32; cells + 1];
+        for &c in cell_of.iter().filter(|&&c| c != u32::MAX) {
+            start[c as usize + 1] += 1;
+        }
+        for c in 0..cells {
+            start[c + 1] += start[c];
+        }
+        let mut next = start[..cells].to_vec();
+        let mut unknowns = vec![0u32; start[cells] as usize];
+        for (i, &c) in cell_of.iter().enumerate().filter(|&(_, &c)| c != u32::MAX) {
+            unknowns[next[c as usize] as usize] = i as u32;
+            next[c as usize] += 1;
+        }
+        Self { start, unknowns }
+    }
+
+    /// The unknowns of each cell in turn.
+    fn cells(&self) -> impl Iterator<Item = &[u32]> {
+        self.start
+            .windows(2)
+            .map(|w| &self.unknowns[w[0] as usize..w[1] as usize])
+    }
+}
+
 impl<const D: usize> Multigrid<D> {
     /// The arrays of the fine level, one entry per unknown each (the coarser levels hold one
     /// entry per cell).
@@ -240,30 +276,35 @@ impl<const D: usize> Multigrid<D> {
         });
 
         let mut first = Level::new(a.dims());
-        let w = Level::<D>::WIDTH;
-        // Each cell's stencil row is the sum of its unknowns' rows, in index order.
-        let mut members: Vec<Vec<usize>> = vec![Vec::new(); first.len()];
-        for (i, &c) in self.fine_cell.iter().enumerate() {
-            if c != u32::MAX {
-                members[c as usize].push(i);
-            }
-        }
-        let diagonals: Vec<Vec<f64>> = first
+        let members = Members::of(&self.fine_cell, first.len());
+        // Each cell's stencil row is the sum of its unknowns' rows, in index order; each row
+        // gives its own a_ii on the way.
+        let mut diagonal = vec![0.0; members.unknowns.len()];
+        let mut tasks = Vec::with_capacity(first.len());
+        let (mut unknowns, mut diagonals) = (&members.unknowns[..], &mut diagonal[..]);
+        for (row, cell) in first
             .stencil
-            .par_chunks_mut(w)
-            .zip(&members)
-            .map(|(row, members)| members.iter().map(|&i| a.add_coarse_row(i, row)).collect())
-            .collect();
+            .chunks_mut(Level::<D>::WIDTH)
+            .zip(members.cells())
+        {
+            let (these, rest) = unknowns.split_at(cell.len());
+            let (d, rest_d) = std::mem::take(&mut diagonals).split_at_mut(cell.len());
+            tasks.push((row, these, d));
+            (unknowns, diagonals) = (rest, rest_d);
+        }
+        tasks.into_par_iter().for_each(|(row, unknowns, diagonal)| {
+            for (&i, d) in unknowns.iter().zip(diagonal) {
+                *d = a.add_coarse_row(i as usize, row);
+            }
+        });
         // The unknowns outside every aggregate are rows of the identity.
         self.fine_inv_diag.clear();
         self.fine_inv_diag.resize(n, 1.0);
-        for (members, diagonals) in members.iter().zip(&diagonals) {
-            for (&i, &d) in members.iter().zip(diagonals) {
-                if d == 0.0 {
-                    return Err(SolverError::ZeroDiagonal { row: i });
-                }
-                self.fine_inv_diag[i] = 1.0 / d;
+        for (&i, &d) in members.unknowns.iter().zip(&diagonal) {
+            if d == 0.0 {
+                return Err(SolverError::ZeroDiagonal { row: i as usize });
             }
+            self.fine_inv_diag[i as usize] = 1.0 / d;
         }
         first.finish();
         self.levels.clear();
