@@ -198,11 +198,33 @@ impl<'a, const D: usize> Neighbours<'a, D> {
     /// F(r) = W'(r)/r and r² F/(r² + η²) (`laplacian_factor`) in lanes, with one division.
     #[inline(always)]
     pub fn gradient_and_laplacian_factors_lanes(&self, r: F64s) -> (F64s, F64s) {
-        let (dw_dr, at_zero) = self.kernel.derivative_lanes(r);
+        let radial = self.radial_terms_lanes(r);
+        let f = r
+            .simd_eq(F64s::ZERO)
+            .select(F64s::splat(self.f_at_zero), radial.k * radial.r2_eta2);
+        (f, radial.k * radial.r2)
+    }
+
+    /// The radial terms of Eq. (27)'s pair weights in lanes (`RadialTerms`), with one division.
+    #[inline(always)]
+    pub fn radial_terms_lanes(&self, r: F64s) -> RadialTerms {
+        let (dw_dr, _) = self.kernel.derivative_lanes(r);
         let r2 = r * r;
         let r2_eta2 = r2 + F64s::splat(self.eta2);
         let inv = F64s::ONE / (r * r2_eta2).fast_max(F64s::splat(f64::MIN_POSITIVE));
-        let f = at_zero.select(F64s::splat(self.f_at_zero), dw_dr * r2_eta2 * inv);
-        (f, dw_dr * r2 * inv)
+        RadialTerms {
+            k: dw_dr * inv,
+            r2,
+            r2_eta2,
+        }
     }
+}
+
+/// k = W'(r)/(r (r² + η²)), r² and r² + η² of a pair: F = W'/r = k (r² + η²) and the
+/// Laplacian factor r² F/(r² + η²) = k r² (Eq. 27). At r = 0, W'(0) = 0 makes k = 0.
+#[derive(Clone, Copy, Debug)]
+pub struct RadialTerms {
+    pub k: F64s,
+    pub r2: F64s,
+    pub r2_eta2: F64s,
 }

@@ -388,14 +388,16 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij = −(2 m̃_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
     #[inline(always)]
     fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, mass: F64s, volume: F64s) -> F64s {
-        let (f, laplacian_factor) = self.nb.gradient_and_laplacian_factors_lanes(l.r);
-        let laplacian = row.scale * mass * laplacian_factor;
+        // a_ij − V_j F ĉ_i·r_ij = k ((−2 m̃_j/ρ_i) r² − V_j (r² + η²) ĉ_i·r_ij), with
+        // F = k (r² + η²) and the Laplacian factor k r² (`RadialTerms`).
+        let radial = self.nb.radial_terms_lanes(l.r);
         let c_r = (0..D).fold(F64s::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
-        let correction = volume * f * c_r;
+        let correction = volume * radial.r2_eta2 * c_r;
+        let weight = radial.k * (row.scale * mass).mul_add(radial.r2, -correction);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
-        (laplacian - correction).fast_max(F64s::ZERO) & l.mask
+        weight.fast_max(F64s::ZERO) & l.mask
     }
 
     /// The weights of interior row i with its fluid neighbours `l`.
