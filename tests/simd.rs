@@ -5,6 +5,7 @@
 use isph::grid::CellList;
 use isph::kernel::{Quintic, SUPPORT_IN_H};
 use isph::linsolve::LinearOperator;
+use isph::multigrid::Aggregated;
 use isph::particles::{Kind, NewParticle, Particles};
 use isph::ppe::{self, PressureOperator, Role};
 use isph::sph::{self, Corrections, Neighbours};
@@ -114,6 +115,15 @@ fn check<const D: usize>(n: i64) {
     let x: Vec<f64> = (0..nf).map(|i| phi(i) * phi(i)).collect();
     let mut ax = vec![0.0; nf];
     op.apply(&x, &mut ax);
+    // The multigrid takes the fine diagonal from the coarse-row pass: it must have the bits of
+    // the operator's own diagonal (the weights summed in the same order).
+    let mut diagonal = vec![0.0; nf];
+    op.diagonal(&mut diagonal);
+    let mut stencil = vec![0.0; 3usize.pow(D as u32)];
+    for i in 0..nf {
+        let a_ii = op.add_coarse_row(i, &mut stencil);
+        assert_eq!(a_ii.to_bits(), diagonal[i].to_bits(), "a_ii of row {i}");
+    }
 
     for i in 0..nf {
         let neighbours = pairs(&p, &kernel, i);
