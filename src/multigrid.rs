@@ -281,16 +281,15 @@ impl<const D: usize> Multigrid<D> {
         // gives its own a_ii on the way.
         let mut diagonal = vec![0.0; members.unknowns.len()];
         let mut tasks = Vec::with_capacity(first.len());
-        let (mut unknowns, mut diagonals) = (&members.unknowns[..], &mut diagonal[..]);
-        for (row, cell) in first
+        let mut diagonals = &mut diagonal[..];
+        for (row, unknowns) in first
             .stencil
             .chunks_mut(Level::<D>::WIDTH)
             .zip(members.cells())
         {
-            let (these, rest) = unknowns.split_at(cell.len());
-            let (d, rest_d) = std::mem::take(&mut diagonals).split_at_mut(cell.len());
-            tasks.push((row, these, d));
-            (unknowns, diagonals) = (rest, rest_d);
+            let (these, rest) = std::mem::take(&mut diagonals).split_at_mut(unknowns.len());
+            tasks.push((row, unknowns, these));
+            diagonals = rest;
         }
         tasks.into_par_iter().for_each(|(row, unknowns, diagonal)| {
             for (&i, d) in unknowns.iter().zip(diagonal) {

@@ -157,8 +157,9 @@ fn violent_impact_keeps_density_volume_and_order() {
     let density = stats_column(out, "density_error");
     // The issue asks for < 1% at every step. Measured (docs/stabilisation.md): 0.85% at worst
     // over 3,406 steps, 0.41% on average (0.89% over 3,430 steps before the pair weights of
-    // `ppe` were computed from k = W'/(r (r² + η²)): another round-off, another trajectory); frames every 0.01 s instead of 0.05 s (a different
-    // trajectory of this chaotic flow after the plunge): 0.86%; a/40: 0.88%. The worst step
+    // `ppe` were computed from k = W'/(r (r² + η²)): another round-off, another trajectory);
+    // frames every 0.01 s instead of 0.05 s (a different trajectory of this chaotic flow after
+    // the plunge): 0.86%; a/40: 0.88%. The worst step
     // moves by ±0.2% with any change to the scheme: the margin is thin by nature. Before the
     // near-surface pressure reference of `step::pressure_reference`: 1.38% at worst, 125 steps
     // above 1%.
