@@ -156,9 +156,9 @@ fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize) {
 /// arithmetic, draws another. Measured over perturbed trajectories (frames every 0.05 s, the
 /// test, and 0.04, 0.03, 0.025 s; docs/stabilisation.md): at a/40 the worst step is 0.66–0.93%
 /// over four (0.64–0.84% over four more with one multigrid sweep), the mean over the steps
-/// 0.31–0.36%. Elsewhere the bound is broken on some trajectories: a/25 1.48%, a/30
-/// 0.95–1.12% (two of four above), a/50 1.09% on one of three (water coming apart in a corner
-/// where the pressure is cut at zero).
+/// 0.31–0.36%. Elsewhere the bound is broken on some trajectories: a/25 1.29%, a/30
+/// 0.95–1.12% (two of four above), a/50 0.58–0.75% on three but 1.09% on one of three more
+/// (water coming apart in a corner where the pressure is cut at zero).
 #[test]
 fn violent_impact_keeps_density_and_volume() {
     let (dir, frames) = violent_impact(40.0, "", "impact");
