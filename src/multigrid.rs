@@ -40,10 +40,11 @@ const COARSEST: usize = 64;
 /// Jacobi sweeps on the coarsest level.
 const COARSEST_SWEEPS: usize = 40;
 /// Jacobi sweeps before and after the coarse correction on the other structured levels. A
-/// sweep costs a 3^D stencil per cell, next to nothing against one particle apply; on the 3D
-/// dam break, 3 sweeps instead of 1 take BiCGSTAB from 19.5 to 14.0 iterations per step at 10⁵
-/// fluid particles and from 23.0 to 16.5 at 10⁶ (2: 14.7 and 8: 13.0 at 10⁵;
-/// docs/performance.md).
+/// sweep costs a 3^D stencil per cell of the whole container; on the 3D dam break, 3 sweeps
+/// instead of 1 take BiCGSTAB from 19.5 to 14.0 iterations per step at 10⁵ fluid particles and
+/// from 23.0 to 16.5 at 10⁶ (2: 14.7 and 8: 13.0 at 10⁵), the step 16% faster. In a 2D tank
+/// that is mostly air, with about one cell per fluid particle, they cost more than they save
+/// (`dam_break_2d`: 7–11% slower; docs/performance.md).
 const SMOOTHING_SWEEPS: usize = 3;
 
 /// A particle operator whose unknowns are grouped into the cells of a grid of `dims` cells

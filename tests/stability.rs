@@ -194,10 +194,12 @@ fn shifting_keeps_the_violent_impact_ordered() {
         "[effects.shifting]\nenabled = false\n",
         "impact_unshifted",
     );
-    let unshifted = stats_column(plain.path(), "disorder");
-    let unshifted_end = unshifted[unshifted.len() / 2..].iter().sum::<f64>()
-        / (unshifted.len() - unshifted.len() / 2) as f64;
-    let shifted_end = disorder[half..].iter().sum::<f64>() / (disorder.len() - half) as f64;
+    let second_half_mean = |v: &[f64]| {
+        let half = &v[v.len() / 2..];
+        half.iter().sum::<f64>() / half.len() as f64
+    };
+    let unshifted_end = second_half_mean(&stats_column(plain.path(), "disorder"));
+    let shifted_end = second_half_mean(&disorder);
     assert!(
         shifted_max < 0.2,
         "disorder with shifting reached {shifted_max}"
