@@ -11,13 +11,17 @@
 //! piecewise-constant interpolation leaves too small on smooth errors and is scaled by
 //! `OVER_CORRECTION` (Blaheta 1986; Vaněk, Mandel & Brezina 1996 for the analysis).
 //!
+//! A level is held over its active cells only, the cells holding unknowns, in compressed rows:
+//! in a tank that is mostly air or dry wall the empty cells would otherwise cost as much as the
+//! water (`dam_break_2d`: 1,700 cells on level 1 for 1,800 fluid particles).
+//!
 //! On the particles the two parts are added, not applied one after the other (an additive
 //! two-level method): z = D⁻¹ r + s P V(Pᵀ r), V the V-cycle of level 1. A multiplicative
 //! cycle (smooth, correct, smooth) converges in fewer iterations but applies the particle
 //! operator twice per preconditioner call, four times per BiCGSTAB iteration on top of
 //! BiCGSTAB's own two; the additive one applies it never. Measured on the 3D dam break at 10⁴
-//! and 10⁵ fluid particles: 14.5 and 17.5 BiCGSTAB iterations per step against 10 and 11.5,
-//! the pressure solve about 1.5 times faster (docs/performance.md). The weight s of the coarse
+//! and 10⁵ fluid particles, with one smoothing sweep: 14.5 and 17.5 BiCGSTAB iterations per
+//! step against 10 and 11.5, the pressure solve about 1.5 times faster (docs/performance.md). The weight s of the coarse
 //! part (`COARSE_WEIGHT`) was picked on those runs (s = 0.5 … 1.6: 16.5 … 22.5 iterations at 10⁵).
 //!
 //! The preconditioner is a fixed linear map of the residual, as BiCGSTAB needs, and every sum
@@ -39,13 +43,15 @@ const COARSE_WEIGHT: f64 = 0.85;
 const COARSEST: usize = 64;
 /// Jacobi sweeps on the coarsest level.
 const COARSEST_SWEEPS: usize = 40;
-/// Jacobi sweeps before and after the coarse correction on the other structured levels. A
-/// sweep costs a 3^D stencil per cell of the whole container; on the 3D dam break, 3 sweeps
-/// instead of 1 take BiCGSTAB from 19.5 to 14.0 iterations per step at 10⁵ fluid particles and
-/// from 23.0 to 16.5 at 10⁶ (2: 14.7 and 8: 13.0 at 10⁵), the step 16% faster. In a 2D tank
-/// that is mostly air, with about one cell per fluid particle, they cost more than they save
-/// (`dam_break_2d`: 7–11% slower; docs/performance.md).
+/// Jacobi sweeps before and after the coarse correction on the other structured levels. On
+/// the 3D dam break, 3 sweeps instead of 1 take BiCGSTAB from 19.5 to 14.0 iterations per step
+/// at 10⁵ fluid particles and from 23.0 to 16.5 at 10⁶ (2: 14.7 and 8: 13.0 at 10⁵), the step
+/// 16% faster; held over the active cells only they make the 2D default scene faster too
+/// (docs/performance.md).
 const SMOOTHING_SWEEPS: usize = 3;
+/// A level with fewer active cells than this computes its residual on the calling thread: a
+/// row is a few dozen flops, less than handing the work to the pool costs.
+const PARALLEL_CELLS: usize = 8192;
 
 /// A particle operator whose unknowns are grouped into the cells of a grid of `dims` cells
 /// (x fastest): the fine level of the multigrid.
@@ -79,15 +85,60 @@ fn cell_offset<const D: usize>(dims: [usize; D], from: usize, to: usize) -> [i64
     })
 }
 
-/// One structured level: a 3^D stencil per cell.
+/// The 3^D-point stencils of one structured level, one row of `3^D` coefficients per cell of
+/// its grid, x fastest: the form the Galerkin products are summed in.
+struct Stencils<const D: usize> {
+    dims: [usize; D],
+    rows: Vec<f64>,
+}
+
+impl<const D: usize> Stencils<D> {
+    const WIDTH: usize = 3usize.pow(D as u32);
+    const CENTRE: usize = (Self::WIDTH - 1) / 2;
+
+    fn new(dims: [usize; D]) -> Self {
+        let n: usize = dims.iter().product();
+        Self {
+            dims,
+            rows: vec![0.0; n * Self::WIDTH],
+        }
+    }
+
+    fn row(&self, c: usize) -> &[f64] {
+        &self.rows[c * Self::WIDTH..(c + 1) * Self::WIDTH]
+    }
+
+    /// Calls `f(n, a_cn)` for the nonzero coefficients of cell c's row, in stencil-slot order,
+    /// with n the neighbour cell's grid index.
+    fn for_each_coefficient(&self, c: usize, mut f: impl FnMut(usize, f64)) {
+        let row = self.row(c);
+        for_each_offset::<D>(|slot, offset| {
+            if row[slot] != 0.0 {
+                if let Some(n) = neighbour(self.dims, c, offset) {
+                    f(n, row[slot]);
+                }
+            }
+        });
+    }
+}
+
+/// One structured level, held over its active cells only: the cells holding unknowns. The
+/// others (air, dry walls: most of a tank that is mostly empty) would have the identity row
+/// and a zero right-hand side, solution and residual, so they are left out.
 struct Level<const D: usize> {
     dims: [usize; D],
-    /// Stencil rows, 3^D coefficients per cell.
-    stencil: Vec<f64>,
+    /// Grid index of each active cell, ascending.
+    cells: Vec<u32>,
+    /// The operator in compressed rows over the active cells: row k's coefficients are
+    /// `value[start[k]..start[k + 1]]`, in stencil-slot order, coupling active cell k to
+    /// active cells `column[..]`.
+    start: Vec<u32>,
+    column: Vec<u32>,
+    value: Vec<f64>,
     inv_diag: Vec<f64>,
-    /// Cells holding unknowns; the others (empty cells of the grid: air, dry walls) have the
-    /// identity row, and their right-hand side, solution and residual stay zero.
-    active: Vec<bool>,
+    /// The active cell of the next coarser level holding each active cell (empty on the
+    /// coarsest).
+    parent: Vec<u32>,
     /// Right-hand side, solution and residual of this level.
     b: Vec<f64>,
     x: Vec<f64>,
@@ -95,82 +146,95 @@ struct Level<const D: usize> {
 }
 
 impl<const D: usize> Level<D> {
-    const WIDTH: usize = 3usize.pow(D as u32);
-    const CENTRE: usize = (Self::WIDTH - 1) / 2;
-
-    fn new(dims: [usize; D]) -> Self {
-        let n = dims.iter().product();
-        Self {
-            dims,
-            stencil: vec![0.0; n * Self::WIDTH],
-            inv_diag: vec![0.0; n],
-            active: vec![false; n],
-            b: vec![0.0; n],
-            x: vec![0.0; n],
-            r: vec![0.0; n],
+    /// The level of the stencils' active cells: those with a nonzero diagonal.
+    fn of(stencils: &Stencils<D>) -> Self {
+        let centre = Stencils::<D>::CENTRE;
+        let grid_cells = stencils.rows.len() / Stencils::<D>::WIDTH;
+        let cells: Vec<u32> = (0..grid_cells)
+            .filter(|&c| stencils.row(c)[centre] != 0.0)
+            .map(|c| c as u32)
+            .collect();
+        let mut level = Self {
+            dims: stencils.dims,
+            start: vec![0],
+            column: Vec::new(),
+            value: Vec::new(),
+            inv_diag: cells
+                .iter()
+                .map(|&c| 1.0 / stencils.row(c as usize)[centre])
+                .collect(),
+            parent: Vec::new(),
+            b: vec![0.0; cells.len()],
+            x: vec![0.0; cells.len()],
+            r: vec![0.0; cells.len()],
+            cells,
+        };
+        for k in 0..level.cells.len() {
+            stencils.for_each_coefficient(level.cells[k] as usize, |n, a| {
+                let n = level
+                    .active_index(n)
+                    .expect("a coupled cell holds unknowns");
+                level.column.push(n as u32);
+                level.value.push(a);
+            });
+            level.start.push(level.column.len() as u32);
         }
+        level
     }
 
     fn len(&self) -> usize {
-        self.b.len()
+        self.cells.len()
     }
 
-    /// Cells with no coupling (no unknown in them) get the identity row.
-    fn finish(&mut self) {
-        let w = Self::WIDTH;
-        for c in 0..self.len() {
-            let row = &mut self.stencil[c * w..(c + 1) * w];
-            self.active[c] = row[Self::CENTRE] != 0.0;
-            if !self.active[c] {
-                row.fill(0.0);
-                row[Self::CENTRE] = 1.0;
-            }
-            self.inv_diag[c] = 1.0 / row[Self::CENTRE];
-        }
+    /// The active index of grid cell c, if active.
+    fn active_index(&self, c: usize) -> Option<usize> {
+        self.cells.binary_search(&(c as u32)).ok()
     }
 
-    /// r = b − A x on this level (b − x for the identity rows of inactive cells).
+    /// r = b − A x on this level.
     fn residual(&mut self) {
-        let w = Self::WIDTH;
-        let (stencil, x, b, dims) = (&self.stencil, &self.x, &self.b, self.dims);
-        let active = &self.active;
-        fill(&mut self.r, |c| {
-            if !active[c] {
-                return b[c] - x[c];
+        let (start, column, value, x, b) =
+            (&self.start, &self.column, &self.value, &self.x, &self.b);
+        let row = |k: usize| {
+            let entries = start[k] as usize..start[k + 1] as usize;
+            column[entries.clone()]
+                .iter()
+                .zip(&value[entries])
+                .fold(b[k], |s, (&n, &a)| s - a * x[n as usize])
+        };
+        if self.r.len() < PARALLEL_CELLS {
+            for (k, r) in self.r.iter_mut().enumerate() {
+                *r = row(k);
             }
-            let row = &stencil[c * w..(c + 1) * w];
-            let mut s = b[c];
-            for_each_offset::<D>(|slot, offset| {
-                if row[slot] != 0.0 {
-                    if let Some(n) = neighbour(dims, c, offset) {
-                        s -= row[slot] * x[n];
-                    }
-                }
-            });
-            s
-        });
+        } else {
+            fill(&mut self.r, row);
+        }
     }
 
-    /// The next coarser level: 2^D cells merged, A_c = Pᵀ A P over the active cells.
-    fn coarsen(&self) -> Level<D> {
-        let dims = self.dims.map(|n| n.div_ceil(2));
-        let mut coarse = Level::new(dims);
-        let w = Self::WIDTH;
-        for c in (0..self.len()).filter(|&c| self.active[c]) {
-            let parent = parent_cell(self.dims, dims, c);
-            let row = &self.stencil[c * w..(c + 1) * w];
-            for_each_offset::<D>(|slot, offset| {
-                if row[slot] == 0.0 {
-                    return;
-                }
-                if let Some(n) = neighbour(self.dims, c, offset) {
-                    let to = parent_cell(self.dims, dims, n);
-                    let s = stencil_slot(cell_offset(dims, parent, to));
-                    coarse.stencil[parent * w + s] += row[slot];
-                }
-            });
+    /// The next coarser level: 2^D cells merged, A_c = Pᵀ A P. Sets this level's `parent`.
+    fn coarsen(&mut self) -> Level<D> {
+        let mut stencils = Stencils::new(self.dims.map(|n| n.div_ceil(2)));
+        let w = Stencils::<D>::WIDTH;
+        for k in 0..self.len() {
+            let parent = parent_cell(self.dims, stencils.dims, self.cells[k] as usize);
+            for e in self.start[k] as usize..self.start[k + 1] as usize {
+                let n = self.cells[self.column[e] as usize] as usize;
+                let to = parent_cell(self.dims, stencils.dims, n);
+                let s = stencil_slot(cell_offset(stencils.dims, parent, to));
+                stencils.rows[parent * w + s] += self.value[e];
+            }
         }
-        coarse.finish();
+        let coarse = Level::of(&stencils);
+        self.parent = self
+            .cells
+            .iter()
+            .map(|&c| {
+                let p = parent_cell(self.dims, coarse.dims, c as usize);
+                coarse
+                    .active_index(p)
+                    .expect("an active cell's parent is active") as u32
+            })
+            .collect();
         coarse
     }
 }
@@ -282,16 +346,16 @@ impl<const D: usize> Multigrid<D> {
             a.aggregate(i).map_or(u32::MAX, |c| c as u32)
         });
 
-        let mut first = Level::new(a.dims());
-        let members = Members::of(&self.fine_cell, first.len());
+        let mut first = Stencils::new(a.dims());
+        let members = Members::of(&self.fine_cell, first.rows.len() / Stencils::<D>::WIDTH);
         // Each cell's stencil row is the sum of its unknowns' rows, in index order; each row
         // gives its own a_ii on the way.
         let mut diagonal = vec![0.0; members.unknowns.len()];
-        let mut tasks = Vec::with_capacity(first.len());
+        let mut tasks = Vec::with_capacity(members.start.len());
         let mut diagonals = &mut diagonal[..];
         for (row, unknowns) in first
-            .stencil
-            .chunks_mut(Level::<D>::WIDTH)
+            .rows
+            .chunks_mut(Stencils::<D>::WIDTH)
             .zip(members.cells())
         {
             let (these, rest) = std::mem::take(&mut diagonals).split_at_mut(unknowns.len());
@@ -312,11 +376,25 @@ impl<const D: usize> Multigrid<D> {
             }
             self.fine_inv_diag[i as usize] = 1.0 / d;
         }
-        first.finish();
+        let first = Level::of(&first);
+        // From here on an aggregated unknown names its cell by its active index in level 1.
+        for c in self.fine_cell.iter_mut().filter(|c| **c != u32::MAX) {
+            *c = first
+                .active_index(*c as usize)
+                .expect("a cell with unknowns is active") as u32;
+        }
         self.levels.clear();
         self.levels.push(first);
-        while self.levels.last().expect("a level").len() > COARSEST {
-            let next = self.levels.last().expect("a level").coarsen();
+        while self
+            .levels
+            .last()
+            .expect("a level")
+            .dims
+            .iter()
+            .product::<usize>()
+            > COARSEST
+        {
+            let next = self.levels.last_mut().expect("a level").coarsen();
             self.levels.push(next);
         }
         Ok(())
@@ -354,16 +432,14 @@ impl<const D: usize> Multigrid<D> {
         level.residual();
         let coarse = &mut tail[0];
         coarse.b.fill(0.0);
-        for c in 0..level.len() {
-            let parent = parent_cell(level.dims, coarse.dims, c);
-            coarse.b[parent] += level.r[c];
+        for (&p, &r) in level.parent.iter().zip(&level.r) {
+            coarse.b[p as usize] += r;
         }
         self.cycle(k + 1);
         let (head, tail) = self.levels.split_at_mut(k + 1);
         let (level, coarse) = (&mut head[k], &tail[0]);
-        for c in 0..level.len() {
-            let parent = parent_cell(level.dims, coarse.dims, c);
-            level.x[c] += OVER_CORRECTION * coarse.x[parent];
+        for (x, &p) in level.x.iter_mut().zip(&level.parent) {
+            *x += OVER_CORRECTION * coarse.x[p as usize];
         }
         for _ in 0..SMOOTHING_SWEEPS {
             smooth(level);

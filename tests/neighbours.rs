@@ -61,6 +61,13 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
         grid.for_each_range_around(i, x, &KINDS, |r, image, kind| around.push((r, image, kind)));
         grid.for_each_neighbour_range(x, &KINDS, |r, image, kind| searched.push((r, image, kind)));
         assert_eq!(around, searched, "ranges around particle {i}");
+        // The multigrid's aggregate of a particle: its block, x fastest in a grid of blocks.
+        let (blocks, mut block, mut stride) = (grid.blocks(), 0, 1);
+        for d in 0..D {
+            block += grid.block_along(d, x[d]) as usize * stride;
+            stride *= blocks[d];
+        }
+        assert_eq!(grid.block_of_sorted(i), block, "block of particle {i}");
     }
     for i in 0..n {
         let mut fast = Vec::new();
