@@ -21,8 +21,9 @@
 //! operator twice per preconditioner call, four times per BiCGSTAB iteration on top of
 //! BiCGSTAB's own two; the additive one applies it never. Measured on the 3D dam break at 10⁴
 //! and 10⁵ fluid particles, with one smoothing sweep: 14.5 and 17.5 BiCGSTAB iterations per
-//! step against 10 and 11.5, the pressure solve about 1.5 times faster (docs/performance.md). The weight s of the coarse
-//! part (`COARSE_WEIGHT`) was picked on those runs (s = 0.5 … 1.6: 16.5 … 22.5 iterations at 10⁵).
+//! step against 10 and 11.5, the pressure solve about 1.5 times faster (docs/performance.md).
+//! The weight s of the coarse part (`COARSE_WEIGHT`) was picked on those runs (s = 0.5 … 1.6:
+//! 16.5 … 22.5 iterations at 10⁵).
 //!
 //! The preconditioner is a fixed linear map of the residual, as BiCGSTAB needs, and every sum
 //! runs in a fixed order: the result does not depend on the thread count.
