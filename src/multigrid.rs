@@ -105,6 +105,11 @@ impl<const D: usize> Stencils<D> {
         }
     }
 
+    /// Cells of the grid.
+    fn cells(&self) -> usize {
+        self.rows.len() / Self::WIDTH
+    }
+
     fn row(&self, c: usize) -> &[f64] {
         &self.rows[c * Self::WIDTH..(c + 1) * Self::WIDTH]
     }
@@ -150,8 +155,7 @@ impl<const D: usize> Level<D> {
     /// The level of the stencils' active cells: those with a nonzero diagonal.
     fn of(stencils: &Stencils<D>) -> Self {
         let centre = Stencils::<D>::CENTRE;
-        let grid_cells = stencils.rows.len() / Stencils::<D>::WIDTH;
-        let cells: Vec<u32> = (0..grid_cells)
+        let cells: Vec<u32> = (0..stencils.cells())
             .filter(|&c| stencils.row(c)[centre] != 0.0)
             .map(|c| c as u32)
             .collect();
@@ -185,6 +189,11 @@ impl<const D: usize> Level<D> {
 
     fn len(&self) -> usize {
         self.cells.len()
+    }
+
+    /// Cells of the level's grid, active or not.
+    fn grid_cells(&self) -> usize {
+        self.dims.iter().product()
     }
 
     /// The active index of grid cell c, if active.
@@ -348,7 +357,7 @@ impl<const D: usize> Multigrid<D> {
         });
 
         let mut first = Stencils::new(a.dims());
-        let members = Members::of(&self.fine_cell, first.rows.len() / Stencils::<D>::WIDTH);
+        let members = Members::of(&self.fine_cell, first.cells());
         // Each cell's stencil row is the sum of its unknowns' rows, in index order; each row
         // gives its own a_ii on the way.
         let mut diagonal = vec![0.0; members.unknowns.len()];
@@ -386,15 +395,7 @@ impl<const D: usize> Multigrid<D> {
         }
         self.levels.clear();
         self.levels.push(first);
-        while self
-            .levels
-            .last()
-            .expect("a level")
-            .dims
-            .iter()
-            .product::<usize>()
-            > COARSEST
-        {
+        while self.levels.last().expect("a level").grid_cells() > COARSEST {
             let next = self.levels.last_mut().expect("a level").coarsen();
             self.levels.push(next);
         }
