@@ -9,7 +9,7 @@ use rayon::prelude::*;
 /// same bits for any thread count.
 const CHUNK: usize = 2048;
 
-/// Length of the blocks the per-particle loops (`fill`, `fill_vector`) hand to a thread. Their
+/// Length of the blocks the per-particle loops (`fill`, `fill_vector`, …) hand to a thread. Their
 /// results do not depend on how the work is split, so the blocks can be short: a 2D scene of a
 /// couple of thousand fluid particles (fewer than one `CHUNK`) still keeps every thread busy.
 const BLOCK: usize = 128;
@@ -70,23 +70,58 @@ pub fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync) {
 
 /// out[d][i] = f(i)[d] for every i: a per-particle vector result written into SoA components.
 pub fn fill_vector<const D: usize>(out: &mut [Vec<f64>; D], f: impl Fn(usize) -> [f64; D] + Sync) {
+    component_blocks(out)
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(c, mut block)| {
+            for k in 0..block[0].len() {
+                set(&mut block, k, f(c * BLOCK + k));
+            }
+        });
+}
+
+/// (a[i], b[i]) ← f(i, b[i]) for every i, with a[i] and b[i] the vectors of particle i in the
+/// SoA components of `a` and `b`: two per-particle vector results of one pass, the second
+/// replacing the vector it is computed from.
+pub fn fill_vector_and_update<const D: usize>(
+    a: &mut [Vec<f64>; D],
+    b: &mut [Vec<f64>; D],
+    f: impl Fn(usize, [f64; D]) -> ([f64; D], [f64; D]) + Sync,
+) {
+    assert_eq!(a[0].len(), b[0].len(), "one vector per particle in each");
+    component_blocks(a)
+        .into_par_iter()
+        .zip(component_blocks(b))
+        .enumerate()
+        .for_each(|(c, (mut block_a, mut block_b))| {
+            for k in 0..block_a[0].len() {
+                let (x, y) = f(c * BLOCK + k, std::array::from_fn(|d| block_b[d][k]));
+                set(&mut block_a, k, x);
+                set(&mut block_b, k, y);
+            }
+        });
+}
+
+/// The SoA components of `out` in blocks of `BLOCK` particles: block c holds particles
+/// c·BLOCK … of every component.
+fn component_blocks<const D: usize>(out: &mut [Vec<f64>; D]) -> Vec<[&mut [f64]; D]> {
     let n = out[0].len();
     let mut chunks = out.each_mut().map(|v| v.chunks_mut(BLOCK));
-    let blocks: Vec<[&mut [f64]; D]> = (0..n.div_ceil(BLOCK))
+    (0..n.div_ceil(BLOCK))
         .map(|_| {
             chunks
                 .each_mut()
                 .map(|c| c.next().expect("components have equal length"))
         })
-        .collect();
-    blocks.into_par_iter().enumerate().for_each(|(c, block)| {
-        for k in 0..block[0].len() {
-            let v = f(c * BLOCK + k);
-            for d in 0..D {
-                block[d][k] = v[d];
-            }
-        }
-    });
+        .collect()
+}
+
+/// Writes vector v into row k of a block of components.
+#[inline]
+fn set<const D: usize>(block: &mut [&mut [f64]; D], k: usize, v: [f64; D]) {
+    for d in 0..D {
+        block[d][k] = v[d];
+    }
 }
 
 /// Σ_i a[i] b[i] in fixed chunks.

@@ -20,7 +20,7 @@ use crate::multigrid::Multigrid;
 use crate::neighbours::Lanes;
 use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
-use crate::reduce::{self, fill, fill_vector};
+use crate::reduce::{self, fill, fill_vector, fill_vector_and_update};
 use crate::scene::Effects;
 use crate::shifting::{Shifting, ShiftingSettings};
 use crate::sph::{self, Correction, Corrections, Neighbours, NO_SLOT};
@@ -119,6 +119,8 @@ pub struct Workspace<const D: usize> {
     pressure_corrections: Vec<Correction<D>>,
     /// Smagorinsky eddy viscosity ν_t (with LES).
     eddy: Vec<f64>,
+    /// u* of Eq. (5), from the predictor to the corrector, which leaves ∇Pⁿ⁺¹ in its place
+    /// for the shifting's Taylor step (Eq. 9): the same gradient, not computed twice.
     u_star: [Vec<f64>; D],
     /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
     row_vectors: [Vec<f64>; D],
@@ -290,7 +292,10 @@ impl<const D: usize> Workspace<D> {
                 ArraySize::of("L'", pressure_corrections),
             ),
             (Stage::EddyViscosity, ArraySize::of("ν_t", eddy)),
-            (Stage::Predictor, ArraySize::of_components("u*", u_star)),
+            (
+                Stage::Predictor,
+                ArraySize::of_components("u*, then ∇P", u_star),
+            ),
             (
                 Stage::PressureSolve,
                 ArraySize::of_components("row vector", row_vectors),
@@ -515,7 +520,7 @@ impl<const D: usize> Workspace<D> {
 
     /// Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls
     /// as ghosts; particles touching a wall face keep no velocity into it
-    /// (`Faces::no_penetration`).
+    /// (`Faces::no_penetration`). ∇Pⁿ⁺¹ is left in place of u*.
     fn correct(
         &mut self,
         nb: &Neighbours<D>,
@@ -528,17 +533,16 @@ impl<const D: usize> Workspace<D> {
         for a in &mut self.velocity {
             a.resize(n, 0.0);
         }
-        let u_star = &self.u_star;
         let corrections =
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         let touch = touching_distance(set.spacing);
         let (roles, full) = (&self.roles, &self.full_support);
-        fill_vector(&mut self.velocity, |i| {
+        fill_vector_and_update(&mut self.velocity, &mut self.u_star, |i, u_star| {
             let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
             let grad = pressure_gradient(nb, p, set.ghost_gravity, corrections.of(i), p_ref, i);
             let rho0 = p.rest_density[i];
-            let u = std::array::from_fn(|d| u_star[d][i] - dt * grad[d] / rho0);
-            faces.no_penetration(p.position(i), u, touch)
+            let u = std::array::from_fn(|d| u_star[d] - dt * grad[d] / rho0);
+            (faces.no_penetration(p.position(i), u, touch), grad)
         });
     }
 
@@ -619,14 +623,11 @@ impl<const D: usize> Workspace<D> {
             let dr = vector(shift, i);
             std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
         });
-        let pressure_corrections =
-            Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
+        // ∇Pⁿ⁺¹ at rⁿ, left by the corrector (the walls' pressures for a frame do not enter it).
+        let grad_p = &self.u_star;
         let clip = self.reference.is_none();
         fill(&mut self.pressure, |i| {
-            let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
-            let l = pressure_corrections.of(i);
-            let g = pressure_gradient(nb, p, set.ghost_gravity, l, p_ref, i);
-            let dr = vector(shift, i);
+            let (g, dr) = (vector(grad_p, i), vector(shift, i));
             cavitation(
                 clip,
                 p.pressure[i] + (0..D).map(|d| g[d] * dr[d]).sum::<f64>(),
