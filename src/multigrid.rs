@@ -152,13 +152,12 @@ struct Level<const D: usize> {
 }
 
 impl<const D: usize> Level<D> {
-    /// The level of the stencils' active cells: those with a nonzero diagonal.
-    fn of(stencils: &Stencils<D>) -> Self {
+    /// The level of `stencils` over its active cells `cells` (grid indices, ascending): the
+    /// cells holding unknowns. A cell whose unknowns couple to nothing (every weight of their
+    /// rows clipped: spray torn off at a large time step) has a zero diagonal here and takes no
+    /// smoothing correction.
+    fn of(stencils: &Stencils<D>, cells: Vec<u32>) -> Self {
         let centre = Stencils::<D>::CENTRE;
-        let cells: Vec<u32> = (0..stencils.cells())
-            .filter(|&c| stencils.row(c)[centre] != 0.0)
-            .map(|c| c as u32)
-            .collect();
         let mut level = Self {
             dims: stencils.dims,
             start: vec![0],
@@ -166,7 +165,14 @@ impl<const D: usize> Level<D> {
             value: Vec::new(),
             inv_diag: cells
                 .iter()
-                .map(|&c| 1.0 / stencils.row(c as usize)[centre])
+                .map(|&c| {
+                    let d = stencils.row(c as usize)[centre];
+                    if d != 0.0 {
+                        1.0 / d
+                    } else {
+                        0.0
+                    }
+                })
                 .collect(),
             parent: Vec::new(),
             b: vec![0.0; cells.len()],
@@ -234,7 +240,14 @@ impl<const D: usize> Level<D> {
                 stencils.rows[parent * w + s] += self.value[e];
             }
         }
-        let coarse = Level::of(&stencils);
+        let mut parents: Vec<u32> = self
+            .cells
+            .iter()
+            .map(|&c| parent_cell(self.dims, stencils.dims, c as usize) as u32)
+            .collect();
+        parents.sort_unstable();
+        parents.dedup();
+        let coarse = Level::of(&stencils, parents);
         self.parent = self
             .cells
             .iter()
@@ -325,6 +338,14 @@ impl Members {
         Self { start, unknowns }
     }
 
+    /// The cells holding unknowns, ascending.
+    fn occupied(&self) -> Vec<u32> {
+        (0..self.start.len() - 1)
+            .filter(|&c| self.start[c + 1] > self.start[c])
+            .map(|c| c as u32)
+            .collect()
+    }
+
     /// The unknowns of each cell in turn.
     fn cells(&self) -> impl Iterator<Item = &[u32]> {
         self.start
@@ -386,7 +407,7 @@ impl<const D: usize> Multigrid<D> {
             }
             self.fine_inv_diag[i as usize] = 1.0 / d;
         }
-        let first = Level::of(&first);
+        let first = Level::of(&first, members.occupied());
         // From here on an aggregated unknown names its cell by its active index in level 1.
         for c in self.fine_cell.iter_mut().filter(|c| **c != u32::MAX) {
             *c = first
