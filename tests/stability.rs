@@ -257,13 +257,14 @@ fn high_viscosity_stays_smooth() {
 }
 
 /// The violent impact at CFL 0.5 and 1.0 (the default is 0.2): no NaN, rare face crossings, no
-/// energy created, and the mean density error bounded — 0.67% on average over the steps at
+/// energy created, and the mean density error bounded — 0.73% on average over the steps at
 /// 0.5 (0.8–0.9% before the near-surface pressure reference of `step::pressure_reference`),
-/// 2.8% at 1.0 (3.4% before; a larger step lets more compression through before the
-/// projection catches it): asserted below 1% and 5%.
+/// 1.29% at 1.0 (1.40% on a trajectory with frames every 0.04 s; a larger step lets more
+/// compression through before the projection catches it): asserted below 1% and 2.5%. Without
+/// the cap on the shift's diffusion number (`shifting`) the mean at 1.0 was 2.8%.
 #[test]
 fn large_cfl_numbers_stay_stable() {
-    for (cfl, bound) in [(0.5, 0.01), (1.0, 0.05)] {
+    for (cfl, bound) in [(0.5, 0.01), (1.0, 0.025)] {
         let width = 0.05715;
         let s = dam_break(width, width / 30.0, &format!("[solver]\ncfl = {cfl}\n"));
         let dir = TempDir::new(&format!("cfl_{cfl}"));
