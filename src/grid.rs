@@ -113,7 +113,10 @@ impl<const D: usize> CellList<D> {
             inv_width: width.map(|w| 1.0 / w),
             dims,
             reach: std::array::from_fn(|d| {
-                let reach = (support / width[d]).ceil() as i64;
+                // A cell is at least support / subdivision(d) wide (a period holds a whole
+                // number of cells no narrower than that), so the quotient exceeds the
+                // subdivision only by the rounding of the width: not a cell more of reach.
+                let reach = ((support / width[d]) * (1.0 - 4.0 * f64::EPSILON)).ceil() as i64;
                 assert!(d == 0 || reach as usize <= MAX_SPAN / 2);
                 reach
             }),

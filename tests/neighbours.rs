@@ -13,14 +13,14 @@ fn lcg(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
-/// The cell-list neighbours of n pseudo-random particles in the unit box, a third of them
-/// walls, against a brute-force search, with the minimum image along the periodic axes (and
-/// the pair vector r_ij too); and the neighbours of one kind only.
-fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
+/// The cell-list neighbours of n pseudo-random particles in the box [0, size]^D, a third of
+/// them walls, against a brute-force search, with the minimum image along the periodic axes
+/// (and the pair vector r_ij too); and the neighbours of one kind only.
+fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D], size: f64) {
     let mut seed = 42;
     let mut p = Particles::<D>::default();
     for k in 0..n {
-        let pos = std::array::from_fn(|_| lcg(&mut seed));
+        let pos = std::array::from_fn(|_| size * lcg(&mut seed));
         p.push(NewParticle {
             pos,
             kind: if k % 3 == 0 { Kind::Wall } else { Kind::Fluid },
@@ -32,7 +32,7 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
         });
     }
     let kernel = Quintic::<D>::new(h);
-    let mut grid = CellList::new([0.0; D], [1.0; D], SUPPORT_IN_H * kernel.h(), periodic);
+    let mut grid = CellList::new([0.0; D], [size; D], SUPPORT_IN_H * kernel.h(), periodic);
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
     grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);
@@ -46,7 +46,7 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
         std::array::from_fn(|d| {
             let r = p.pos[d][i] - p.pos[d][j];
             if periodic[d] {
-                r - r.round()
+                r - size * (r / size).round()
             } else {
                 r
             }
@@ -101,18 +101,27 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D]) {
 
 #[test]
 fn cell_list_finds_exactly_the_brute_force_neighbours() {
-    check::<2>(3000, 0.04, [false; 2]);
-    check::<3>(3000, 0.04, [false; 3]);
+    check::<2>(3000, 0.04, [false; 2], 1.0);
+    check::<3>(3000, 0.04, [false; 3], 1.0);
 }
 
 #[test]
 fn periodic_axes_find_the_nearest_images_across_the_boundary() {
-    check::<2>(3000, 0.04, [true, true]);
-    check::<2>(3000, 0.04, [true, false]);
-    check::<3>(3000, 0.04, [false, true, true]);
+    check::<2>(3000, 0.04, [true, true], 1.0);
+    check::<2>(3000, 0.04, [true, false], 1.0);
+    check::<3>(3000, 0.04, [false, true, true], 1.0);
     // Three cells per periodic axis, the fewest allowed: no neighbour is met twice.
-    check::<2>(400, 0.1, [true, true]);
-    check::<3>(400, 0.1, [true, true, true]);
+    check::<2>(400, 0.1, [true, true], 1.0);
+    check::<3>(400, 0.1, [true, true, true], 1.0);
+}
+
+/// A period of 2.01 m at h = 0.01 m (a scene at dx = 0.01 m, h/dx = 1.0) is 134 cells of
+/// half a support whose width rounds one ulp below it: the reach across those cells, once
+/// rounded up to three, failed an assertion before any step ran.
+#[test]
+fn periodic_cells_a_rounding_short_of_half_a_support() {
+    check::<2>(3000, 0.01, [false, true], 2.01);
+    check::<2>(3000, 0.01, [true, true], 2.01);
 }
 
 #[test]
