@@ -50,6 +50,10 @@ const COARSEST_SWEEPS: usize = 40;
 /// 16% faster; held over the active cells only they make the 2D default scene faster too
 /// (docs/performance.md).
 const SMOOTHING_SWEEPS: usize = 3;
+/// A diagonal at most this fraction of its row's Σ|a| is taken for zero: a cell whose unknowns
+/// couple only to each other has a coarse diagonal that is zero in exact arithmetic, and its
+/// rounding (~1e-16 of the row) would put a factor 1e16 into the smoother.
+const NEGLIGIBLE_DIAGONAL: f64 = 1e-12;
 /// A level with fewer active cells than this computes its residual on the calling thread: a
 /// row is a few dozen flops, less than handing the work to the pool costs.
 const PARALLEL_CELLS: usize = 8192;
@@ -154,8 +158,8 @@ struct Level<const D: usize> {
 impl<const D: usize> Level<D> {
     /// The level of `stencils` over its active cells `cells` (grid indices, ascending): the
     /// cells holding unknowns. A cell whose unknowns couple to nothing (every weight of their
-    /// rows clipped: spray torn off at a large time step) has a zero diagonal here and takes no
-    /// smoothing correction.
+    /// rows clipped: spray torn off at a large time step) has a zero diagonal here, or one
+    /// that is zero but for rounding (`NEGLIGIBLE_DIAGONAL`), and takes no smoothing correction.
     fn of(stencils: &Stencils<D>, cells: Vec<u32>) -> Self {
         let centre = Stencils::<D>::CENTRE;
         let mut level = Self {
@@ -166,9 +170,10 @@ impl<const D: usize> Level<D> {
             inv_diag: cells
                 .iter()
                 .map(|&c| {
-                    let d = stencils.row(c as usize)[centre];
-                    if d != 0.0 {
-                        1.0 / d
+                    let row = stencils.row(c as usize);
+                    let size = row.iter().map(|a| a.abs()).sum::<f64>();
+                    if row[centre] > NEGLIGIBLE_DIAGONAL * size {
+                        1.0 / row[centre]
                     } else {
                         0.0
                     }
