@@ -47,9 +47,14 @@ pub fn sums<const K: usize>(n: usize, f: impl Fn(usize) -> [f64; K] + Sync) -> [
     partial.into_iter().fold([-0.0; K], add)
 }
 
-/// max_i f(i) for i in 0..n (0 when n = 0). A maximum does not depend on the order.
+/// max_i f(i) for i in 0..n (0 when n = 0), NaN if any f(i) is NaN: a NaN speed has to stop
+/// the run as non-finite, not vanish from the maximum as it does from `f64::max`. A maximum
+/// does not depend on the order.
 pub fn max(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
-    (0..n).into_par_iter().map(&f).reduce(|| 0.0, f64::max)
+    (0..n)
+        .into_par_iter()
+        .map(&f)
+        .reduce(|| 0.0, |a, b| if a >= b || a.is_nan() { a } else { b })
 }
 
 /// Number of i in 0..n with `pred(i)`.

@@ -100,3 +100,17 @@ fn fitted_value_is_none_where_the_neighbours_fix_no_plane() {
     let beside = fit(&[&row[..], &[[0, 1]]].concat()).expect("a plane");
     assert!(beside.abs() < 1e-12, "{beside}");
 }
+
+/// A NaN among the values is the maximum: a NaN speed stops the run as non-finite.
+#[test]
+fn the_maximum_keeps_a_nan() {
+    use isph::reduce::max;
+    let values = [0.5, 2.0, 1.0, 0.25];
+    assert_eq!(max(values.len(), |i| values[i]), 2.0);
+    assert_eq!(max(0, |_| 1.0), 0.0);
+    for nan_at in 0..values.len() {
+        let mut v = values;
+        v[nan_at] = f64::NAN;
+        assert!(max(v.len(), |i| v[i]).is_nan(), "NaN at {nan_at}");
+    }
+}
