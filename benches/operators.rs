@@ -9,7 +9,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use isph::bench::{dam_break_scene, PpeSetup};
-use isph::linsolve::{BiCgStab, LinearOperator, SolverParams};
+use isph::linsolve::{BiCgStab, LinearOperator, Preconditioner, SolverParams};
 use isph::multigrid::Multigrid;
 use isph::particles::Particles;
 use isph::reduce::fill;
@@ -81,6 +81,7 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
         Multigrid::<D>::default(),
         vec![0.0; fluid],
     );
+    multigrid.setup(&op).unwrap();
     let info = solver
         .solve(&op, &mut multigrid, &rhs, &mut solution, params)
         .unwrap();
@@ -95,6 +96,7 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
     g.bench_function(label("bicgstab_solve"), |b| {
         b.iter(|| {
             solution.fill(0.0);
+            multigrid.setup(&op).unwrap();
             solver
                 .solve(&op, &mut multigrid, &rhs, &mut solution, params)
                 .unwrap()

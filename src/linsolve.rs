@@ -129,7 +129,8 @@ impl BiCgStab {
         }
     }
 
-    /// Solves A x = b with preconditioner `m`, starting from the `x` given (warm start).
+    /// Solves A x = b with preconditioner `m`, set up for `a` (`Preconditioner::setup`),
+    /// starting from the `x` given (warm start).
     pub fn solve<A: LinearOperator>(
         &mut self,
         a: &A,
@@ -140,7 +141,6 @@ impl BiCgStab {
     ) -> Result<SolveInfo, SolverError> {
         let n = a.len();
         self.resize(n);
-        m.setup(a)?;
 
         let b_norm = norm(b);
         if b_norm == 0.0 {

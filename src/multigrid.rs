@@ -54,6 +54,9 @@ const SMOOTHING_SWEEPS: usize = 3;
 /// couple only to each other has a coarse diagonal that is zero in exact arithmetic, and its
 /// rounding (~1e-16 of the row) would put a factor 1e16 into the smoother.
 const NEGLIGIBLE_DIAGONAL: f64 = 1e-12;
+/// A row of level 1 whose sum exceeds this fraction of its Σ|a| couples to a fixed unknown
+/// (the sum of a row coupled to none is zero but for rounding, ~1e-16 of Σ|a|).
+const ANCHORED_ROW_SUM: f64 = 1e-9;
 /// A level with fewer active cells than this computes its residual on the calling thread: a
 /// row is a few dozen flops, less than handing the work to the pool costs.
 const PARALLEL_CELLS: usize = 8192;
@@ -306,6 +309,15 @@ fn parent_cell<const D: usize>(fine: [usize; D], coarse: [usize; D], c: usize) -
     lin
 }
 
+/// The set of union–find element k (path halving).
+fn find(root: &mut [usize], mut k: usize) -> usize {
+    while root[k] != k {
+        root[k] = root[root[k]];
+        k = root[k];
+    }
+    k
+}
+
 /// The multigrid hierarchy of one PPE and the work vectors of its V-cycle.
 #[derive(Default)]
 pub struct Multigrid<const D: usize> {
@@ -360,6 +372,53 @@ impl Members {
 }
 
 impl<const D: usize> Multigrid<D> {
+    /// The fine unknowns of each region of the first level that no row couples to a fixed
+    /// unknown: cells joined by nonzero couplings, none of whose rows sums above zero (a row of
+    /// level 1 sums to the weight its particles give to the fixed unknowns, the Dirichlet rows).
+    /// Such a region's part of A is singular: water sealed off from the free surface. Unknowns
+    /// in index order, regions by their first unknown; none when every region is anchored.
+    pub fn unanchored_regions(&self) -> Vec<Vec<usize>> {
+        let Some(first) = self.levels.first() else {
+            return Vec::new();
+        };
+        let entries = |k: usize| first.start[k] as usize..first.start[k + 1] as usize;
+        // Union–find over the active cells, each set named by its smallest cell.
+        let mut root: Vec<usize> = (0..first.len()).collect();
+        for k in 0..first.len() {
+            for e in entries(k) {
+                let (a, b) = (
+                    find(&mut root, k),
+                    find(&mut root, first.column[e] as usize),
+                );
+                root[a.max(b)] = a.min(b);
+            }
+        }
+        let mut anchored = vec![false; first.len()];
+        for k in 0..first.len() {
+            let row = &first.value[entries(k)];
+            let size: f64 = row.iter().map(|a| a.abs()).sum();
+            if row.iter().sum::<f64>() > ANCHORED_ROW_SUM * size {
+                anchored[find(&mut root, k)] = true;
+            }
+        }
+        let (mut regions, mut slot) = (Vec::<Vec<usize>>::new(), vec![usize::MAX; first.len()]);
+        for (i, &c) in self.fine_cell.iter().enumerate() {
+            if c == u32::MAX {
+                continue;
+            }
+            let r = find(&mut root, c as usize);
+            if anchored[r] {
+                continue;
+            }
+            if slot[r] == usize::MAX {
+                slot[r] = regions.len();
+                regions.push(Vec::new());
+            }
+            regions[slot[r]].push(i);
+        }
+        regions
+    }
+
     /// The arrays of the fine level, one entry per unknown each (the coarser levels hold one
     /// entry per cell).
     pub fn fine_arrays(&self) -> Vec<ArraySize> {

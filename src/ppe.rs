@@ -111,12 +111,23 @@ pub fn pin_reference<const D: usize>(
     if roles.iter().any(|r| r.is_free()) {
         return None;
     }
-    let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
-    let top = (0..roles.len())
-        .filter(|&i| roles[i] == Role::Interior)
-        .max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)))?;
+    let top = highest(
+        p,
+        gravity,
+        (0..roles.len()).filter(|&i| roles[i] == Role::Interior),
+    )?;
     roles[top] = Role::Reference;
     Some(top)
+}
+
+/// The highest of the particles `among` against gravity, the first in index order among equals.
+pub fn highest<const D: usize>(
+    p: &Particles<D>,
+    gravity: [f64; D],
+    among: impl Iterator<Item = usize>,
+) -> Option<usize> {
+    let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
+    among.max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)))
 }
 
 /// Marks fluid particles whose kernel support holds no free-surface particle: there the
@@ -170,13 +181,16 @@ fn surface_pressure(rest_density: f64, gravity: f64, spacing: f64) -> f64 {
 }
 
 /// Right-hand side b of the PPE rows (same sign convention as `PressureOperator`); `closed`:
-/// the fluid has no free surface (a particle is pinned as the reference); `density_rate`:
-/// α/Δt_max, the rate at which the density-invariance term relaxes the density error
-/// (`divergence_source`).
+/// the fluid has no free surface (a particle is pinned as the reference); `sealed`: the
+/// unknowns of each region sealed off from the free surface where the rest has one (its
+/// highest particle pinned), whose compression is balanced like a closed box's;
+/// `density_rate`: α/Δt_max, the rate at which the density-invariance term relaxes the
+/// density error (`divergence_source`).
 #[allow(clippy::too_many_arguments)]
 pub fn source<const D: usize>(
     op: &PressureOperator<D>,
     closed: bool,
+    sealed: &[Vec<usize>],
     full: &[bool],
     spacing: f64,
     corrections: Corrections<D>,
@@ -207,6 +221,17 @@ pub fn source<const D: usize>(
     } else {
         0.0
     };
+    for region in sealed {
+        let rows: Vec<usize> = region
+            .iter()
+            .copied()
+            .filter(|&i| op.roles[i] == Role::Interior)
+            .collect();
+        let mean = rows.iter().map(|&i| b[i]).sum::<f64>() / rows.len().max(1) as f64;
+        for i in rows {
+            b[i] -= mean;
+        }
+    }
     // The walls' known differences (the Neumann ghosts) complete the interior rows.
     b.par_iter_mut()
         .zip(op.roles)

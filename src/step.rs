@@ -14,7 +14,7 @@ use crate::free_surface::Support;
 use crate::grid::CellList;
 use crate::kernel::Quintic;
 use crate::lanes::F64s;
-use crate::linsolve::{BiCgStab, SolveInfo, SolverError, SolverParams};
+use crate::linsolve::{BiCgStab, Preconditioner, SolveInfo, SolverError, SolverParams};
 use crate::memory::{ArraySize, Holds};
 use crate::multigrid::Multigrid;
 use crate::neighbours::Lanes;
@@ -198,8 +198,6 @@ impl<const D: usize> Workspace<D> {
             p.density[..nf].copy_from_slice(&self.density);
             lap(Stage::Density);
             self.classify(&nb, p, set, nf);
-            let roles = &self.roles;
-            fill(&mut p.free_surface[..nf], |i| roles[i].code());
             lap(Stage::FreeSurface);
             if effects.kernel_correction {
                 self.near_surface_corrections(&nb, p);
@@ -214,6 +212,8 @@ impl<const D: usize> Workspace<D> {
             let solve = self.solve_pressure(&nb, p, set, step)?;
             let (clip, pressure) = (self.reference.is_none(), &self.pressure);
             fill(&mut p.pressure[..nf], |i| cavitation(clip, pressure[i]));
+            let roles = &self.roles;
+            fill(&mut p.free_surface[..nf], |i| roles[i].code());
             lap(Stage::PressureSolve);
             self.correct(&nb, p, set, faces, dt);
             copy_vector(&self.velocity, &mut p.vel);
@@ -477,19 +477,27 @@ impl<const D: usize> Workspace<D> {
             &mut self.row_vectors,
         );
         ppe::fluid_volumes(p, n, &mut self.fluid_volume);
-        let op = PressureOperator {
-            nb,
-            p,
-            roles: &self.roles,
-            row_vectors: &self.row_vectors,
-            fluid_volume: &self.fluid_volume,
-            gravity: set.gravity,
-            ghost_gravity: set.ghost_gravity,
-            interfaces: set.interfaces,
-        };
+        let (rows, volumes) = (&self.row_vectors, &self.fluid_volume);
+        self.multigrid
+            .setup(&pressure_operator(nb, p, set, &self.roles, rows, volumes))?;
+        // Water sealed off from the free surface (a compartment under a lid, a pocket against
+        // a wall) has no pressure level of its own: its highest particle is pinned to P = 0,
+        // the role the free surface plays elsewhere, and the hierarchy rebuilt.
+        let sealed = self.multigrid.unanchored_regions();
+        for region in &sealed {
+            let top = ppe::highest(p, set.gravity, region.iter().copied())
+                .expect("a region holds unknowns");
+            self.roles[top] = Role::Reference;
+        }
+        if !sealed.is_empty() {
+            self.multigrid
+                .setup(&pressure_operator(nb, p, set, &self.roles, rows, volumes))?;
+        }
+        let op = pressure_operator(nb, p, set, &self.roles, rows, volumes);
         ppe::source(
             &op,
             self.reference.is_some(),
+            &sealed,
             &self.full_support,
             set.spacing,
             Corrections::sparse(kernel_correction, &self.correction_slot, &self.corrections),
@@ -648,6 +656,27 @@ impl<const D: usize> Workspace<D> {
                     *x += dt * vel[i] + s;
                 });
         }
+    }
+}
+
+/// The PPE operator of the particles' `roles` (`solve_pressure`).
+fn pressure_operator<'a, const D: usize>(
+    nb: &'a Neighbours<'a, D>,
+    p: &'a Particles<D>,
+    set: &StepSettings<D>,
+    roles: &'a [Role],
+    row_vectors: &'a [Vec<f64>; D],
+    fluid_volume: &'a [f64],
+) -> PressureOperator<'a, D> {
+    PressureOperator {
+        nb,
+        p,
+        roles,
+        row_vectors,
+        fluid_volume,
+        gravity: set.gravity,
+        ghost_gravity: set.ghost_gravity,
+        interfaces: set.interfaces,
     }
 }
 

@@ -1,7 +1,7 @@
 //! BiCGSTAB against a dense direct solve on a non-symmetric sparse system, and with the
 //! multigrid preconditioner on rows that couple to nothing.
 
-use isph::linsolve::{BiCgStab, Jacobi, LinearOperator, SolverParams};
+use isph::linsolve::{BiCgStab, Jacobi, LinearOperator, Preconditioner, SolverParams};
 use isph::multigrid::{stencil_slot, Aggregated, Multigrid};
 
 /// 1D convection–diffusion: −x_{i−1}(1 + c) + 2 x_i (1 + s_i) − x_{i+1}(1 − c), non-symmetric.
@@ -82,8 +82,10 @@ fn bicgstab_matches_a_dense_solve_of_a_nonsymmetric_system() {
         tolerance: 1e-10,
         max_iterations: 2000,
     };
+    let mut jacobi = Jacobi::default();
+    jacobi.setup(&a).unwrap();
     let info = BiCgStab::default()
-        .solve(&a, &mut Jacobi::default(), &b, &mut x, params)
+        .solve(&a, &mut jacobi, &b, &mut x, params)
         .unwrap();
     assert!(info.converged && info.relative_residual <= 1e-9, "{info:?}");
     let err = x
@@ -97,7 +99,7 @@ fn bicgstab_matches_a_dense_solve_of_a_nonsymmetric_system() {
 
     // A warm start from the solution needs (almost) no iteration.
     let info = BiCgStab::default()
-        .solve(&a, &mut Jacobi::default(), &b, &mut x, params)
+        .solve(&a, &mut jacobi, &b, &mut x, params)
         .unwrap();
     assert!(info.iterations <= 1, "{info:?}");
 }
@@ -198,8 +200,10 @@ fn multigrid_takes_cells_whose_rows_couple_to_nothing() {
         tolerance: 1e-10,
         max_iterations: 500,
     };
+    let mut multigrid = Multigrid::<2>::default();
+    multigrid.setup(&a).unwrap();
     let info = BiCgStab::default()
-        .solve(&a, &mut Multigrid::<2>::default(), &b, &mut x, params)
+        .solve(&a, &mut multigrid, &b, &mut x, params)
         .unwrap();
     assert!(
         info.converged && info.relative_residual <= 1e-10,
