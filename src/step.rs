@@ -576,7 +576,8 @@ impl<const D: usize> Workspace<D> {
             [1.0, error, nearest, nearest * nearest]
         });
         if count == 0.0 {
-            return (0.0, 0.0);
+            // Nothing measured (a layer too thin for a full support anywhere): not a zero error.
+            return (f64::NAN, f64::NAN);
         }
         let mean = distance / count;
         let variance = (square / count - mean * mean).max(0.0);
