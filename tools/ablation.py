@@ -106,10 +106,10 @@ def stats(out: Path) -> dict:
     return {
         "steps": len(rows),
         "t_end": col("time")[-1],
-        "density_mean": col("density_error").mean(),
-        "density_max": col("density_error").max(),
+        "density_mean": np.nanmean(col("density_error")),
+        "density_max": np.nanmax(col("density_error")),
         "disorder_end": col("disorder")[-1],
-        "disorder_max": col("disorder").max(),
+        "disorder_max": np.nanmax(col("disorder")),
         "penetrations": int(col("penetrations").max()),
         "max_speed_end": col("max_speed")[-1],
         "ppe_iterations": col("ppe_iterations").mean(),

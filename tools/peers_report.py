@@ -52,7 +52,7 @@ def isph_fields(out, scene_path):
         "iterations_mean": "%.2f" % col("ppe_iterations").mean(),
         "compression_mean": "%.3e" % np.maximum(ratio, 0.0).mean(),
         "density_error_last": "%.3e" % error[-1],
-        "density_error_mean": "%.3e" % error.mean(),
+        "density_error_mean": "%.3e" % np.nanmean(error),
         "penetrations_last": int(col("penetrations")[-1]),
     }
 
