@@ -701,12 +701,12 @@ impl Validator<'_> {
             self.check(
                 (spacings - spacings.round()).abs() < 1e-6 * spacings,
                 key,
-                format!("axis {d} is periodic, so its length {length} m must be a whole number of spacings ({spacing} m); it is {spacings}"),
+                format!("axis {d} is periodic, so its length {length} m must be a whole number of spacings ({spacing} m); it is {spacings:.4} spacings"),
             )?;
             self.check(
                 length >= 3.0 * support,
                 key,
-                format!("axis {d} is periodic, so its length {length} m must be at least three kernel supports (3 × 3h = {} m)", 3.0 * support),
+                format!("axis {d} is periodic, so its length {length} m must be at least three kernel supports (3 × 3h = {:.4} m)", 3.0 * support),
             )?;
         }
         Ok(flags.to_vec())

@@ -199,8 +199,8 @@ fn water_sealed_off_from_the_free_surface_stays_at_rest() {
 /// disorder there: the columns say so (NaN) rather than report a perfect 0.
 #[test]
 fn a_layer_too_thin_for_a_full_support_reports_no_density_error() {
-    let text = crate::common::water_block_scene(0.02)
-        .replace("max = [0.2, 0.2]", "max = [0.4, 0.08]");
+    let text =
+        crate::common::water_block_scene(0.02).replace("max = [0.2, 0.2]", "max = [0.4, 0.08]");
     let dir = TempDir::new("thin-layer");
     run_scene(&scene_from_text(&text), dir.path(), 0.02);
     for column in ["density_error", "disorder"] {
@@ -215,5 +215,8 @@ fn a_layer_too_thin_for_a_full_support_reports_no_density_error() {
         0.02,
     );
     let values = stats_column(deep.path(), "density_error");
-    assert!(values.iter().all(|v| v.is_finite() && *v < 0.01), "{values:?}");
+    assert!(
+        values.iter().all(|v| v.is_finite() && *v < 0.01),
+        "{values:?}"
+    );
 }
