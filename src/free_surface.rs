@@ -16,8 +16,8 @@
 //!    eigenvector of λ_i, the direction in which the support is emptiest. A particle inside a
 //!    gap of the fluid or squeezed against a wall has a neighbour in every umbrella; one on
 //!    the surface has none in at least one.
-//! 3. A particle whose summation density is below 0.9 ρ0 is free surface whatever λ_i says:
-//!    spray — loose particles at a breaking front or an impact, each with some neighbour in
+//! 3. A particle whose summation density is below 0.9 ρ0 (at h/dx = 1.2, scaled with the
+//!    kernel's reach: `spray_density`) is free surface whatever λ_i says: spray — loose particles at a breaking front or an impact, each with some neighbour in
 //!    every umbrella but no fluid around it — and sparse fluid beside a wall, whose wall
 //!    particles fill the moment matrix. A Laplacian row there sees a few neighbours converging
 //!    at impact speed and answers with a pressure spike that blows the spray apart.
@@ -28,6 +28,7 @@
 //!    1.12 ρ0 between the floor and the water behind it; its row then answered with 4.9 kPa
 //!    and shot it out at 2.8 m/s, 35% faster than the front (2.1 m/s with this rule).
 
+use crate::kernel::Quintic;
 use crate::sph::Neighbours;
 use crate::vector::{dot, norm};
 
@@ -35,9 +36,44 @@ use crate::vector::{dot, norm};
 const SPLASH_EIGENVALUE: f64 = 0.2;
 /// λ_i above which a particle is interior without the scan (Marrone et al.).
 const INTERIOR_EIGENVALUE: f64 = 0.75;
-/// ρ_i/ρ0 below which a particle is spray or sparse fluid: on a lattice at h/dx = 1.2 the
-/// summation density is 0.73 ρ0 on a flat free surface and 0.97 ρ0 one row below it.
+/// ρ_i/ρ0 below which a particle is spray or sparse fluid at h/dx = `SPRAY_H_OVER_DX`
+/// (`spray_density` scales it to other h/dx): on a lattice at h/dx = 1.2 the summation density
+/// is 0.73 ρ0 on a flat free surface, 0.97 ρ0 one row below it and 0.93 ρ0 at the corner of a
+/// 3D block one layer in.
 const SPRAY_DENSITY: f64 = 0.9;
+/// The h/dx `SPRAY_DENSITY` was set at.
+const SPRAY_H_OVER_DX: f64 = 1.2;
+
+/// ρ_i/ρ0 below which a particle is spray or sparse fluid (rule 3 above), for the quintic
+/// kernel at `h_over_dx`: 0.9 at h/dx = 1.2, scaled with the summation density of the most
+/// truncated particle that is not on the surface of a block of fluid, the corner of its
+/// second layer, which the rule must leave alone. A wider kernel reaches further out of the
+/// water: that corner holds 0.98 ρ0 at h/dx = 1.0, 0.93 at 1.2, 0.82 at 1.5 and 0.65 at 2.0 in
+/// 3D (0.99, 0.95, 0.87, 0.74 in 2D), so a fixed 0.9 took it, and from h/dx ≈ 1.75 on a whole
+/// flat second row, for spray, fixed their pressure at the surface's and let the water's top
+/// fall.
+pub fn spray_density<const D: usize>(h_over_dx: f64) -> f64 {
+    SPRAY_DENSITY
+        * (second_corner_density::<D>(h_over_dx) / second_corner_density::<D>(SPRAY_H_OVER_DX))
+}
+
+/// Σ_j W_ij dx^D at the corner of the second layer of a block filling the negative quadrant
+/// (octant) of a lattice of unit spacing: the lattice points at most one spacing from it
+/// along every axis towards the outside.
+fn second_corner_density<const D: usize>(h_over_dx: f64) -> f64 {
+    let kernel = Quintic::<D>::new(h_over_dx);
+    let reach = kernel.support().ceil() as i64;
+    let span = 2 * reach + 1;
+    let mut sum = 0.0;
+    for k in 0..span.pow(D as u32) {
+        let offset: [f64; D] =
+            std::array::from_fn(|d| ((k / span.pow(d as u32)) % span - reach) as f64);
+        if offset.iter().all(|&o| o <= 1.0) {
+            sum += kernel.w(norm(offset));
+        }
+    }
+    sum
+}
 
 /// How the neighbours fill the kernel support of a fluid particle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,12 +116,18 @@ impl<const D: usize> Support<D> {
     }
 
     /// Whether fluid particle `i` with this support and summation density ρ_i = `density_ratio`
-    /// ρ0 lies on the free surface.
-    pub fn is_free_surface(&self, nb: &Neighbours<D>, i: usize, density_ratio: f64) -> bool {
+    /// ρ0 lies on the free surface; `spray_density` is the kernel's `spray_density`.
+    pub fn is_free_surface(
+        &self,
+        nb: &Neighbours<D>,
+        i: usize,
+        density_ratio: f64,
+        spray_density: f64,
+    ) -> bool {
         if density_ratio > 1.0 {
             return false;
         }
-        if self.is_splash() || density_ratio < SPRAY_DENSITY {
+        if self.is_splash() || density_ratio < spray_density {
             return true;
         }
         if self.lambda > INTERIOR_EIGENVALUE {

@@ -76,24 +76,20 @@ pub fn fluid_volumes<const D: usize>(p: &Particles<D>, nf: usize, out: &mut Vec<
 /// The role of particle i: fluid on the free surface (see `free_surface`) takes the surface
 /// row, or P = 0 where it has no consistent gradient (`gradient_defined` false: the moment
 /// matrix of its pressure gradient is near-singular, whether or not the scene applies the
-/// kernel correction). Fluid that fills its container (`confined`) has no free surface: every
-/// fluid row is interior (a disordered patch of a periodic flow can look like a surface to the
-/// detection). `fluid_neighbours` counts the fluid particles in its kernel support.
+/// kernel correction). `fluid_neighbours` counts the fluid particles in its kernel support;
+/// `spray_density` is the kernel's `free_surface::spray_density`.
 pub fn role<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     support: &Support<D>,
     fluid_neighbours: usize,
     gradient_defined: bool,
-    confined: bool,
+    spray_density: f64,
     i: usize,
 ) -> Role {
-    if confined {
-        return Role::Interior;
-    }
     if fluid_neighbours == 0 || !gradient_defined {
         Role::Splash
-    } else if support.is_free_surface(nb, i, p.density[i] / p.rest_density[i]) {
+    } else if support.is_free_surface(nb, i, p.density[i] / p.rest_density[i], spray_density) {
         Role::Surface
     } else {
         Role::Interior

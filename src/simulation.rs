@@ -2,6 +2,7 @@
 //! projection step of `step`, and the diagnostics of each step.
 
 use crate::faces::{Contact, Faces};
+use crate::free_surface;
 use crate::grid::CellList;
 use crate::kernel::{Quintic, SUPPORT_IN_H};
 use crate::lattice;
@@ -129,6 +130,7 @@ impl<const D: usize> Simulation<D> {
                 },
                 effects: scene.effects,
                 confined,
+                spray_density: free_surface::spray_density::<D>(scene.solver.h_over_dx),
                 interfaces: scene
                     .fluids
                     .iter()

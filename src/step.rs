@@ -47,6 +47,8 @@ pub struct StepSettings<const D: usize> {
     /// The fluid fills a closed or periodic container (`lattice::fills_container`): it has no
     /// free surface, and none is looked for.
     pub confined: bool,
+    /// ρ/ρ0 below which fluid is spray, for the scene's h/dx (`free_surface::spray_density`).
+    pub spray_density: f64,
     /// The fluids differ in rest density: the PPE rows weigh pairs across an interface
     /// (`ppe::laplacian_mass`).
     pub interfaces: bool,
@@ -361,15 +363,22 @@ impl<const D: usize> Workspace<D> {
                 let mo = sph::support_moments(nb, p, i);
                 let l_pressure = sph::gradient_correction(mo.m_neumann);
                 let support = Support::new(&mo.m, mo.grad_c);
-                *role = ppe::role(
-                    nb,
-                    p,
-                    &support,
-                    mo.fluid_neighbours,
-                    l_pressure.is_some(),
-                    set.confined,
-                    i,
-                );
+                // Fluid that fills its container has no free surface: every row is interior
+                // (a disordered patch of a periodic flow can look like a surface to the
+                // detection).
+                *role = if set.confined {
+                    Role::Interior
+                } else {
+                    ppe::role(
+                        nb,
+                        p,
+                        &support,
+                        mo.fluid_neighbours,
+                        l_pressure.is_some(),
+                        set.spray_density,
+                        i,
+                    )
+                };
                 if let Some(normal) = normal {
                     *normal = support.normal;
                 }
