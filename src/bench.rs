@@ -282,7 +282,7 @@ impl<const D: usize> PpeSetup<D> {
         ppe::row_vectors(
             &nb,
             p,
-            false,
+            None,
             &roles,
             Corrections::new(false, &[]),
             &mut row_vectors,
@@ -315,7 +315,7 @@ impl<const D: usize> PpeSetup<D> {
             fluid_volume: &self.fluid_volume,
             gravity,
             ghost_gravity: gravity,
-            interfaces: false,
+            interfaces: None,
         }
     }
 

@@ -12,6 +12,7 @@ pub mod child;
 pub mod faces;
 pub mod free_surface;
 pub mod grid;
+pub mod interface;
 pub mod io;
 pub mod kernel;
 pub mod lanes;

@@ -15,15 +15,14 @@
 //! first in the sorted order).
 
 use crate::free_surface::Support;
+use crate::interface::pair_weight;
 use crate::lanes::{F64s, Sum, LANES};
 use crate::linsolve::LinearOperator;
 use crate::multigrid::{stencil_slot, Aggregated};
 use crate::neighbours::Lanes;
 use crate::particles::{Kind, Particles};
 use crate::reduce::{fill, fill_vector};
-use crate::sph::{
-    interface_weight, mass_at_density, velocity_gradient, Correction, Corrections, Neighbours,
-};
+use crate::sph::{mass_at_density, velocity_gradient, Correction, Corrections, Neighbours};
 use crate::wall::{behind_walls, ghost_pressure_difference, ghost_velocity};
 use rayon::prelude::*;
 
@@ -153,7 +152,7 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 pub fn row_vectors<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    interfaces: bool,
+    interfaces: Option<&[f64]>,
     roles: &[Role],
     pressure_corrections: Corrections<D>,
     out: &mut [Vec<f64>; D],
@@ -312,32 +311,71 @@ fn divergence_source<const D: usize>(
 }
 
 /// m̃_j, the mass neighbour j counts with in the Laplacian row of particle i (Eq. 27): m_j
-/// where the fluids share one rest density. Where they do not (`interfaces`), row i is
-/// ρ0_i ∇·(∇P/ρ) with the harmonic mean 2/(ρ0_i + ρ0_j) of 1/ρ across a pair (Cummins &
-/// Rudman 1999), which keeps ∇P/ρ continuous across an interface and a stable layering at
-/// rest: a_ij = −2 V_j (2ρ0_i/(ρ0_i + ρ0_j)) r_ij·∇W_ij/(r_ij² + η²), i.e.
-/// m̃_j = m_j 2ρ0_i²/(ρ0_j (ρ0_i + ρ0_j)); a wall ghost is one of i's own fluid,
-/// m̃_b = m_b ρ0_i/ρ0_b = ρ0_i V_b. Both are exactly m_j where ρ0_j = ρ0_i.
+/// where the fluids share one rest density. Where they do not (`interfaces`: each fluid
+/// particle's distance to the nearest interface, `interface::Interfaces::distance`), row i is
+/// ρ0_i ∇·(∇P/ρ) with 1/ρ̄_ij across a pair, ρ̄_ij the density along the segment between them
+/// (`interface::pair_weight`), which keeps ∇P/ρ continuous across an interface and a stable
+/// layering at rest: a_ij = −2 V_j (ρ0_i/ρ̄_ij) r_ij·∇W_ij/(r_ij² + η²), i.e.
+/// m̃_j = m_j ρ0_i²/(ρ0_j ρ̄_ij); a wall ghost is one of i's own fluid, m̃_b = m_b ρ0_i/ρ0_b =
+/// ρ0_i V_b. Both are exactly m_j where ρ0_j = ρ0_i. `row` holds ρ0_i and i's distance.
 #[inline(always)]
 fn laplacian_mass<const D: usize>(
     p: &Particles<D>,
-    interfaces: bool,
-    rest_density: F64s,
+    interfaces: Option<&[f64]>,
+    row: &RowDensity,
     l: &Lanes<D>,
 ) -> F64s {
-    if !interfaces {
-        return l.load(&p.mass);
+    let mass = volume_mass(p, interfaces.is_some(), row, l);
+    match (interfaces, l.kind) {
+        (Some(distance), Kind::Fluid) => {
+            let weight = pair_weight(
+                row.rest_density,
+                l.load(&p.rest_density),
+                row.distance,
+                l.load(distance),
+            );
+            mass * weight
+        }
+        _ => mass,
     }
-    let mass = mass_at_density(p, rest_density, l);
-    match l.kind {
-        Kind::Fluid => mass * interface_weight(rest_density, l.load(&p.rest_density)),
-        Kind::Wall => mass,
+}
+
+/// ρ0_i V_j, the mass of neighbour j's volume at i's rest density: m_j where the fluids share
+/// one (`interfaces` false), every neighbour counted as one of i's own fluid where they do not.
+#[inline(always)]
+fn volume_mass<const D: usize>(
+    p: &Particles<D>,
+    interfaces: bool,
+    row: &RowDensity,
+    l: &Lanes<D>,
+) -> F64s {
+    if interfaces {
+        mass_at_density(p, row.rest_density, l)
+    } else {
+        l.load(&p.mass)
+    }
+}
+
+/// ρ0_i and particle i's distance to the nearest interface (0 without interfaces), in lanes.
+#[derive(Clone, Copy, Debug)]
+struct RowDensity {
+    rest_density: F64s,
+    distance: F64s,
+}
+
+impl RowDensity {
+    fn of<const D: usize>(p: &Particles<D>, interfaces: Option<&[f64]>, i: usize) -> Self {
+        Self {
+            rest_density: F64s::splat(p.rest_density[i]),
+            distance: F64s::splat(interfaces.map_or(0.0, |d| d[i])),
+        }
     }
 }
 
 /// First-order consistency of the Laplacian of Eq. (27). Where the free surface truncates the
 /// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with
-/// c_i = 2 Σ_j (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support). A wall ghost
+/// c_i = 2 Σ_j (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support; every
+/// neighbour counted as one of i's own fluid, m_j = ρ0_i V_j, where the fluids differ). A wall ghost
 /// continues only the normal part of the field, so a wall neighbour contributes N_b r_ij (see
 /// `wall`): beside a plane wall the wall supplies what the missing fluid would, but in a corner
 /// or where the surface meets a wall the support is truncated for the tangential part too.
@@ -349,17 +387,20 @@ fn laplacian_mass<const D: usize>(
 fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    interfaces: bool,
+    interfaces: Option<&[f64]>,
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
     let mut c = [Sum::ZERO; D];
     let scale = F64s::splat(2.0 / p.rest_density[i]);
-    let rest_density = F64s::splat(p.rest_density[i]);
+    let row = RowDensity::of(p, interfaces, i);
     nb.for_each_lanes(i, |lanes| {
         let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(lanes.r);
-        // −a_ij of Eq. (27) (`sph::laplacian_coefficient`).
-        let mass = laplacian_mass(p, interfaces, rest_density, lanes);
+        // −a_ij of Eq. (27) (`sph::laplacian_coefficient`) for the kernel's truncation alone:
+        // across an interface the pairs are weighted by design (`laplacian_mass`), and taken
+        // for truncation that weighting would be undone, leaving one fluid's pressure gradient
+        // through both.
+        let mass = volume_mass(p, interfaces.is_some(), &row, lanes);
         let cl = (scale * mass * laplacian_factor) & lanes.mask;
         let followed = match lanes.kind {
             Kind::Fluid => lanes.rij,
@@ -388,16 +429,16 @@ pub struct PressureOperator<'a, const D: usize> {
     pub gravity: [f64; D],
     /// The gravity the wall ghosts' pressures carry (`StepSettings::ghost_gravity`).
     pub ghost_gravity: [f64; D],
-    /// The fluids differ in rest density (`laplacian_mass`).
-    pub interfaces: bool,
+    /// Where the fluids differ in rest density, each fluid particle's distance to the nearest
+    /// interface (`laplacian_mass`).
+    pub interfaces: Option<&'a [f64]>,
 }
 
 /// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
 struct Row<const D: usize> {
     scale: F64s,
     c: [F64s; D],
-    /// ρ0_i.
-    rest_density: F64s,
+    density: RowDensity,
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
@@ -405,7 +446,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         Row {
             scale: F64s::splat(-2.0 / self.p.rest_density[i]),
             c: std::array::from_fn(|d| F64s::splat(self.row_vectors[d][i])),
-            rest_density: F64s::splat(self.p.rest_density[i]),
+            density: RowDensity::of(self.p, self.interfaces, i),
         }
     }
 
@@ -429,7 +470,7 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// The weights of interior row i with its fluid neighbours `l`.
     #[inline(always)]
     fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> F64s {
-        let mass = laplacian_mass(self.p, self.interfaces, row.rest_density, l);
+        let mass = laplacian_mass(self.p, self.interfaces, &row.density, l);
         self.interior_weights(row, l, mass, l.load(self.fluid_volume))
     }
 
@@ -440,7 +481,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         let mut b = Sum::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
             let volume = l.load(&p.mass) / l.load(&p.rest_density);
-            let mass = laplacian_mass(p, self.interfaces, row.rest_density, l);
+            let mass = laplacian_mass(p, self.interfaces, &row.density, l);
             let w = self.interior_weights(&row, l, mass, volume);
             b += w * ghost_pressure_difference(p, self.ghost_gravity, i, l);
         });

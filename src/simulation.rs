@@ -4,6 +4,7 @@
 use crate::faces::{Contact, Faces};
 use crate::free_surface;
 use crate::grid::CellList;
+use crate::interface::Interfaces;
 use crate::kernel::{Quintic, SUPPORT_IN_H};
 use crate::lattice;
 use crate::linsolve::{SolverError, SolverParams};
@@ -131,10 +132,6 @@ impl<const D: usize> Simulation<D> {
                 effects: scene.effects,
                 confined,
                 spray_density: free_surface::spray_density::<D>(scene.solver.h_over_dx),
-                interfaces: scene
-                    .fluids
-                    .iter()
-                    .any(|f| f.density != scene.fluids[0].density),
             },
             faces: Faces::new(scene),
             cfl: scene.solver.cfl,
@@ -142,7 +139,13 @@ impl<const D: usize> Simulation<D> {
             cell_of: Vec::new(),
             order: Vec::new(),
             scratch: Vec::new(),
-            work: Workspace::default(),
+            work: Workspace::new(
+                scene
+                    .fluids
+                    .iter()
+                    .any(|f| f.density != scene.fluids[0].density)
+                    .then(|| Interfaces::new(&Quintic::<D>::new(h))),
+            ),
             timings: Timings::default(),
         })
     }

@@ -31,17 +31,6 @@ pub fn mass_at_density<const D: usize>(
     l.load(&p.mass) * (rest_density_i / l.load(&p.rest_density))
 }
 
-/// 2ρ0_i/(ρ0_i + ρ0_j): across a pair of fluids, the harmonic mean 2/(ρ0_i + ρ0_j) of 1/ρ
-/// relative to particle i's own 1/ρ0_i; exactly 1 within one fluid. The pressure a pair sees
-/// across an interface is then that of the interface between them, with ∇P/ρ continuous
-/// through it (Hu & Adams 2006; Cummins & Rudman 1999): in a stable layering at rest
-/// ∇P_i/ρ0_i = g on both sides, where the plain difference P_j − P_i averages the two
-/// fluids' hydrostatic gradients and pushes the particles beside the interface.
-#[inline(always)]
-pub fn interface_weight(rest_density_i: F64s, rest_density_j: F64s) -> F64s {
-    F64s::splat(2.0) * rest_density_i / (rest_density_i + rest_density_j)
-}
-
 /// V_j F(r_ij) of the lanes (zero in the masked ones), with V_j = m_j/ρ0_j: the weight of
 /// r_ij in the gradients of Eq. (20) and the moments of Eq. (25).
 #[inline(always)]

@@ -12,6 +12,7 @@
 use crate::faces::Faces;
 use crate::free_surface::Support;
 use crate::grid::CellList;
+use crate::interface::{self, Interfaces};
 use crate::kernel::Quintic;
 use crate::lanes::F64s;
 use crate::linsolve::{BiCgStab, Preconditioner, SolveInfo, SolverError, SolverParams};
@@ -49,9 +50,6 @@ pub struct StepSettings<const D: usize> {
     pub confined: bool,
     /// ρ/ρ0 below which fluid is spray, for the scene's h/dx (`free_surface::spray_density`).
     pub spray_density: f64,
-    /// The fluids differ in rest density: the PPE rows weigh pairs across an interface
-    /// (`ppe::laplacian_mass`).
-    pub interfaces: bool,
 }
 
 /// The stages of a step of a scene with `effects`, in order: those of `Workspace::project`,
@@ -101,6 +99,11 @@ pub struct StepReport {
 pub struct Workspace<const D: usize> {
     /// Summation density of the step (swapped into the particles).
     density: Vec<f64>,
+    /// Where the fluids differ in rest density, the kernel's table of distances to an
+    /// interface (`interface`), and each fluid particle's distance to the nearest one: the
+    /// PPE rows and the pressure gradient weigh the pairs across it.
+    interface_table: Option<Interfaces>,
+    interface_distance: Vec<f64>,
     /// The free surface's outward normal of each fluid particle, where shifting keeps to the
     /// tangential direction (with shifting).
     surface_normal: Vec<[f64; D]>,
@@ -137,10 +140,14 @@ pub struct Workspace<const D: usize> {
     shift: [Vec<f64>; D],
 }
 
-impl<const D: usize> Default for Workspace<D> {
-    fn default() -> Self {
+impl<const D: usize> Workspace<D> {
+    /// The workspace of a scene whose fluids differ in rest density (`interfaces`: the
+    /// kernel's table) or share one (None).
+    pub fn new(interfaces: Option<Interfaces>) -> Self {
         Self {
             density: Vec::new(),
+            interface_table: interfaces,
+            interface_distance: Vec::new(),
             surface_normal: Vec::new(),
             roles: Vec::new(),
             reference: None,
@@ -198,6 +205,7 @@ impl<const D: usize> Workspace<D> {
             };
             self.summation_density(&nb, p, nf);
             p.density[..nf].copy_from_slice(&self.density);
+            self.interface_distances(&nb, p, nf);
             lap(Stage::Density);
             self.classify(&nb, p, set, nf);
             lap(Stage::FreeSurface);
@@ -254,6 +262,8 @@ impl<const D: usize> Workspace<D> {
     pub fn arrays(&self) -> Vec<(Stage, ArraySize)> {
         let Workspace {
             density,
+            interface_table,
+            interface_distance,
             surface_normal,
             roles,
             reference: _,
@@ -320,6 +330,10 @@ impl<const D: usize> Workspace<D> {
         ];
         let solver = bicgstab.arrays().into_iter().chain(multigrid.fine_arrays());
         arrays.extend(solver.map(|a| (Stage::PressureSolve, a)));
+        if interface_table.is_some() {
+            let distance = ArraySize::of("interface distance", interface_distance);
+            arrays.push((Stage::Density, distance));
+        }
         // Every array of the workspace holds the fluid particles only (see the module doc).
         for (_, a) in &mut arrays {
             if a.holds == Holds::EveryParticle {
@@ -333,6 +347,18 @@ impl<const D: usize> Workspace<D> {
     fn summation_density(&mut self, nb: &Neighbours<D>, p: &Particles<D>, nf: usize) {
         self.density.resize(nf, 0.0);
         fill(&mut self.density, |i| sph::density(nb, p, i));
+    }
+
+    /// Each of the `nf` fluid particles' distance to the nearest interface between fluids of
+    /// different rest density (`interface`), where they differ.
+    fn interface_distances(&mut self, nb: &Neighbours<D>, p: &Particles<D>, nf: usize) {
+        let Some(table) = &self.interface_table else {
+            return;
+        };
+        self.interface_distance.resize(nf, 0.0);
+        fill(&mut self.interface_distance, |i| {
+            table.distance(interface::other_fluid_fraction(nb, p, i))
+        });
     }
 
     /// How each support is filled, from its moments (`sph::support_moments`): the free surface
@@ -480,15 +506,23 @@ impl<const D: usize> Workspace<D> {
         ppe::row_vectors(
             nb,
             p,
-            set.interfaces,
+            interfaces(&self.interface_table, &self.interface_distance),
             &self.roles,
             Corrections::new(kernel_correction, &self.pressure_corrections),
             &mut self.row_vectors,
         );
         ppe::fluid_volumes(p, n, &mut self.fluid_volume);
         let (rows, volumes) = (&self.row_vectors, &self.fluid_volume);
-        self.multigrid
-            .setup(&pressure_operator(nb, p, set, &self.roles, rows, volumes))?;
+        let interfaces = interfaces(&self.interface_table, &self.interface_distance);
+        self.multigrid.setup(&pressure_operator(
+            nb,
+            p,
+            set,
+            &self.roles,
+            rows,
+            volumes,
+            interfaces,
+        ))?;
         // Water sealed off from the free surface (a compartment under a lid, a pocket against
         // a wall) has no pressure level of its own: its highest particle is pinned to P = 0,
         // the role the free surface plays elsewhere, and the hierarchy rebuilt.
@@ -499,10 +533,17 @@ impl<const D: usize> Workspace<D> {
             self.roles[top] = Role::Reference;
         }
         if !sealed.is_empty() {
-            self.multigrid
-                .setup(&pressure_operator(nb, p, set, &self.roles, rows, volumes))?;
+            self.multigrid.setup(&pressure_operator(
+                nb,
+                p,
+                set,
+                &self.roles,
+                rows,
+                volumes,
+                interfaces,
+            ))?;
         }
-        let op = pressure_operator(nb, p, set, &self.roles, rows, volumes);
+        let op = pressure_operator(nb, p, set, &self.roles, rows, volumes, interfaces);
         ppe::source(
             &op,
             self.reference.is_some(),
@@ -554,9 +595,10 @@ impl<const D: usize> Workspace<D> {
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         let touch = touching_distance(set.spacing);
         let (roles, full) = (&self.roles, &self.full_support);
+        let interfaces = interfaces(&self.interface_table, &self.interface_distance);
         fill_vector_and_update(&mut self.velocity, &mut self.u_star, |i, u_star| {
             let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
-            let grad = pressure_gradient(nb, p, set.ghost_gravity, corrections.of(i), p_ref, i);
+            let grad = pressure_gradient(nb, p, set, interfaces, corrections.of(i), p_ref, i);
             let rho0 = p.rest_density[i];
             let u = std::array::from_fn(|d| u_star[d] - dt * grad[d] / rho0);
             (faces.no_penetration(p.position(i), u, touch), grad)
@@ -677,6 +719,7 @@ fn pressure_operator<'a, const D: usize>(
     roles: &'a [Role],
     row_vectors: &'a [Vec<f64>; D],
     fluid_volume: &'a [f64],
+    interfaces: Option<&'a [f64]>,
 ) -> PressureOperator<'a, D> {
     PressureOperator {
         nb,
@@ -686,8 +729,14 @@ fn pressure_operator<'a, const D: usize>(
         fluid_volume,
         gravity: set.gravity,
         ghost_gravity: set.ghost_gravity,
-        interfaces: set.interfaces,
+        interfaces,
     }
+}
+
+/// `distance`, each fluid particle's distance to the nearest interface, where the fluids
+/// differ in rest density (`table`; `ppe::laplacian_mass`).
+fn interfaces<'a>(table: &Option<Interfaces>, distance: &'a [f64]) -> Option<&'a [f64]> {
+    table.as_ref().map(|_| distance)
 }
 
 /// The pressures of the wall particles (from index `nf` on), for the frames: the
@@ -724,13 +773,15 @@ fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
 
 /// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25), the differences
 /// taken from `p_ref` (`pressure_reference`), and the walls as ghosts of P_i (see `wall`)
-/// carrying `ghost_gravity`: a particle whose pressure exceeds p_ref is pushed off a wall it
-/// presses on, but not out through a free surface; across the interface of two fluids each
-/// difference is weighted by `sph::interface_weight`.
+/// carrying `set.ghost_gravity`: a particle whose pressure exceeds p_ref is pushed off a wall it
+/// presses on, but not out through a free surface; across the interface of two fluids
+/// (`interfaces`, the distances to it) each difference is weighted by ρ0_i/ρ̄_ij
+/// (`interface::pair_weight`).
 fn pressure_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    ghost_gravity: [f64; D],
+    set: &StepSettings<D>,
+    interfaces: Option<&[f64]>,
     l: &Correction<D>,
     p_ref: f64,
     i: usize,
@@ -738,10 +789,22 @@ fn pressure_gradient<const D: usize>(
     let (p_ref, rest_density) = (F64s::splat(p_ref), F64s::splat(p.rest_density[i]));
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
     let own = F64s::splat(p.pressure[i]) - p_ref;
+    let ghost_gravity = set.ghost_gravity;
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
         Kind::Fluid => {
-            let weight = sph::interface_weight(rest_density, lanes.load(&p.rest_density));
-            (lanes.load(&p.pressure) - p_ref) * weight
+            let difference = lanes.load(&p.pressure) - p_ref;
+            match interfaces {
+                Some(distance) => {
+                    let weight = interface::pair_weight(
+                        rest_density,
+                        lanes.load(&p.rest_density),
+                        F64s::splat(distance[i]),
+                        lanes.load(distance),
+                    );
+                    difference * weight
+                }
+                None => difference,
+            }
         }
         Kind::Wall => own + wall::ghost_pressure_difference(p, ghost_gravity, i, lanes),
     })

@@ -14,6 +14,7 @@ mod effects;
 mod frame_times;
 mod free_surface;
 mod hydrostatic;
+mod interface;
 mod kernel;
 mod linsolve;
 mod neighbours;

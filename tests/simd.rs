@@ -95,7 +95,7 @@ fn check<const D: usize>(n: i64) {
     ppe::row_vectors(
         &nb,
         &p,
-        false,
+        None,
         &roles,
         Corrections::new(false, &[]),
         &mut row_vectors,
@@ -110,7 +110,7 @@ fn check<const D: usize>(n: i64) {
         fluid_volume: &fluid_volume,
         gravity: [0.0; D],
         ghost_gravity: [0.0; D],
-        interfaces: false,
+        interfaces: None,
     };
     let x: Vec<f64> = (0..nf).map(|i| phi(i) * phi(i)).collect();
     let mut ax = vec![0.0; nf];

@@ -1,0 +1,123 @@
+//! Interfaces between fluids of different rest density (src/interface.rs): the distance each
+//! particle reads off the other fluid's share of its kernel, and the pair density between two.
+
+use crate::common::Lattice;
+use isph::interface::{other_fluid_fraction, pair_weight, Interfaces};
+use isph::lanes::F64s;
+use isph::sph::Neighbours;
+
+const DX: f64 = 0.01;
+
+/// A block of lattice particles, those above the plane half a spacing over the middle row
+/// of twice the density: a flat interface. A particle k rows from it reads its distance off
+/// the other fluid's share of its kernel (a continuum's half space, summed over lattice
+/// points): the first row at 0.51–0.53 spacings for 0.5, farther rows in proportion, d_k/d_0
+/// within 5% of 2k + 1 as long as the other fluid lies a spacing inside the support. Only
+/// those ratios enter a pair's density (`pair_weight`).
+fn distances_on_a_lattice<const D: usize>(n: i64, h_over_dx: f64) {
+    let mut lat = Lattice::<D>::part(n, DX, h_over_dx, |_| true);
+    let p = &mut lat.particles;
+    for i in 0..p.len() {
+        if p.pos[D - 1][i] > 0.5 * DX {
+            p.rest_density[i] = 2000.0;
+            p.mass[i] *= 2.0;
+        }
+    }
+    let table = Interfaces::new(&lat.kernel);
+    let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
+    let support = 3.0 * h_over_dx;
+    let reach = support.ceil() as i64;
+    // Distance in spacings, by rows from the interface (0: the two rows beside it).
+    let mut by_row: Vec<Vec<f64>> = vec![Vec::new(); reach as usize];
+    for i in 0..p.len() {
+        let index: Vec<i64> = (0..D).map(|d| (p.pos[d][i] / DX).round() as i64).collect();
+        // Inside the block, beyond the kernel's reach from its sides.
+        if index.iter().any(|c| c.abs() > n / 2 - reach) {
+            continue;
+        }
+        let row = if index[D - 1] <= 0 {
+            -index[D - 1]
+        } else {
+            index[D - 1] - 1
+        };
+        if row < reach {
+            by_row[row as usize].push(table.distance(other_fluid_fraction(&nb, p, i)) / DX);
+        }
+    }
+    let first = by_row[0][0];
+    assert!(
+        (first - 0.5).abs() < 0.05,
+        "D = {D}, h/dx = {h_over_dx}: first row at {first}"
+    );
+    for (k, distances) in by_row.iter().enumerate() {
+        let expected = (2 * k + 1) as f64;
+        assert!(!distances.is_empty());
+        for d in distances {
+            if expected / 2.0 + 1.0 < support {
+                assert!(
+                    (d / first / expected - 1.0).abs() < 0.05,
+                    "D = {D}, h/dx = {h_over_dx}: row {k} at {d} spacings, {} first rows",
+                    d / first
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_distance_to_a_flat_interface_is_read_off_the_kernel() {
+    distances_on_a_lattice::<2>(31, 1.2);
+    distances_on_a_lattice::<3>(19, 1.2);
+    distances_on_a_lattice::<2>(31, 2.0);
+}
+
+#[test]
+fn far_from_any_other_fluid_the_distance_is_the_support_and_inside_it_zero() {
+    let table = Interfaces::new(&isph::kernel::Quintic::<3>::new(0.012));
+    assert!((table.distance(0.0) - 0.036).abs() < 1e-15);
+    assert!(table.distance(0.5) < 1e-4 * 0.012);
+    assert_eq!(table.distance(0.8), 0.0);
+}
+
+#[test]
+fn the_pair_density_is_exact_for_a_stable_layering_and_one_within_a_fluid() {
+    // i in the light fluid half a spacing above the interface, j in the heavy one 2.5 below:
+    // P_j − P_i = g (500 · 0.5 + 1000 · 2.5) dx = g · 3 dx · ρ̄, ρ̄ = 2750/3.
+    let w = pair_weight(
+        F64s::splat(500.0),
+        F64s::splat(1000.0),
+        F64s::splat(0.5),
+        F64s::splat(2.5),
+    );
+    let expected = 500.0 / (2750.0 / 3.0);
+    assert!(w.to_array().iter().all(|&w| (w - expected).abs() < 1e-15));
+    // From j's side the same density: ρ0_j/ρ̄ = 1000/(2750/3).
+    let w = pair_weight(
+        F64s::splat(1000.0),
+        F64s::splat(500.0),
+        F64s::splat(2.5),
+        F64s::splat(0.5),
+    );
+    assert!(w
+        .to_array()
+        .iter()
+        .all(|&w| (w - 3000.0 / 2750.0).abs() < 1e-15));
+    // Within one fluid exactly one, and where both distances are zero the harmonic mean.
+    let one = pair_weight(
+        F64s::splat(800.0),
+        F64s::splat(800.0),
+        F64s::splat(0.3),
+        F64s::splat(1.7),
+    );
+    assert!(one.to_array().iter().all(|&w| w == 1.0));
+    let mean = pair_weight(
+        F64s::splat(500.0),
+        F64s::splat(1000.0),
+        F64s::ZERO,
+        F64s::ZERO,
+    );
+    assert!(mean
+        .to_array()
+        .iter()
+        .all(|&w| (w - 2.0 / 3.0).abs() < 1e-15));
+}
