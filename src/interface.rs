@@ -7,10 +7,11 @@
 //! i to j: ρ̄_ij = f ρ0_i + (1 − f) ρ0_j, with f the fraction of the segment on i's side of the
 //! interface. The harmonic mean 2/(ρ0_i + ρ0_j) of 1/ρ (Cummins & Rudman 1999) is the case
 //! f = ½, exact only where the interface lies halfway between the two; the kernel's support
-//! (3.6 spacings at h/dx = 1.2) holds pairs crossing it anywhere along their length, and with
-//! f = ½ throughout, the lowest row of oil at half the water's density took a pressure 30%
-//! above the hydrostatic one and a stable layering reached 0.25 m/s. The fraction comes from
-//! each particle's distance to the interface along the normal, d_i (`Interfaces::distance`):
+//! (3.6 spacings at h/dx = 1.2) holds pairs crossing it anywhere along their length. With
+//! f = ½ a stable layering of a fluid at half the water's density over water reached 0.19 m/s
+//! in 0.6 s where this one stays at 0.03 (`tests/hydrostatic.rs`, and
+//! `ppe::laplacian_correction` for the other half of that fix). The fraction comes from each
+//! particle's distance to the interface along the normal, d_i (`Interfaces::distance`):
 //! f = d_i/(d_i + d_j), whatever the pair's direction.
 
 use crate::kernel::Quintic;

@@ -514,34 +514,24 @@ impl<const D: usize> Workspace<D> {
         ppe::fluid_volumes(p, n, &mut self.fluid_volume);
         let (rows, volumes) = (&self.row_vectors, &self.fluid_volume);
         let interfaces = interfaces(&self.interface_table, &self.interface_distance);
-        self.multigrid.setup(&pressure_operator(
-            nb,
-            p,
-            set,
-            &self.roles,
-            rows,
-            volumes,
-            interfaces,
-        ))?;
         // Water sealed off from the free surface (a compartment under a lid, a pocket against
         // a wall) has no pressure level of its own: its highest particle is pinned to P = 0,
-        // the role the free surface plays elsewhere, and the hierarchy rebuilt.
-        let sealed = self.multigrid.unanchored_regions();
-        for region in &sealed {
-            let top = ppe::highest(p, set.gravity, region.iter().copied())
-                .expect("a region holds unknowns");
-            self.roles[top] = Role::Reference;
-        }
-        if !sealed.is_empty() {
-            self.multigrid.setup(&pressure_operator(
-                nb,
-                p,
-                set,
-                &self.roles,
-                rows,
-                volumes,
-                interfaces,
-            ))?;
+        // the role the free surface plays elsewhere, and the hierarchy rebuilt (a pinned
+        // region is anchored, so the second pass finds none).
+        let mut sealed = Vec::new();
+        loop {
+            let op = pressure_operator(nb, p, set, &self.roles, rows, volumes, interfaces);
+            self.multigrid.setup(&op)?;
+            let unanchored = self.multigrid.unanchored_regions();
+            if unanchored.is_empty() {
+                break;
+            }
+            for region in &unanchored {
+                let top = ppe::highest(p, set.gravity, region.iter().copied())
+                    .expect("a region holds unknowns");
+                self.roles[top] = Role::Reference;
+            }
+            sealed.extend(unanchored);
         }
         let op = pressure_operator(nb, p, set, &self.roles, rows, volumes, interfaces);
         ppe::source(
