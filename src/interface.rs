@@ -9,8 +9,8 @@
 //! f = ½, exact only where the interface lies halfway between the two; the kernel's support
 //! (3.6 spacings at h/dx = 1.2) holds pairs crossing it anywhere along their length. With
 //! f = ½ a stable layering of a fluid at half the water's density over water reached 0.19 m/s
-//! in 0.6 s where this one stays at 0.03 (`tests/hydrostatic.rs`, and
-//! `ppe::laplacian_correction` for the other half of that fix). The fraction comes from each
+//! in 0.6 s where this one stays at 0.03 (`tests/hydrostatic.rs`; `ppe::laplacian_correction`
+//! and `ppe::across_interfaces` for the other half of that fix). The fraction comes from each
 //! particle's distance to the interface along the normal, d_i (`Interfaces::distance`):
 //! f = d_i/(d_i + d_j), whatever the pair's direction.
 

@@ -310,33 +310,37 @@ fn divergence_source<const D: usize>(
     -(rho0 / dt * div + density_term)
 }
 
-/// m̃_j, the mass neighbour j counts with in the Laplacian row of particle i (Eq. 27): m_j
-/// where the fluids share one rest density. Where they do not (`interfaces`: each fluid
-/// particle's distance to the nearest interface, `interface::Interfaces::distance`), row i is
-/// ρ0_i ∇·(∇P/ρ) with 1/ρ̄_ij across a pair, ρ̄_ij the density along the segment between them
-/// (`interface::pair_weight`), which keeps ∇P/ρ continuous across an interface and a stable
-/// layering at rest: a_ij = −2 V_j (ρ0_i/ρ̄_ij) r_ij·∇W_ij/(r_ij² + η²), i.e.
-/// m̃_j = m_j ρ0_i²/(ρ0_j ρ̄_ij); a wall ghost is one of i's own fluid, m̃_b = m_b ρ0_i/ρ0_b =
-/// ρ0_i V_b. Both are exactly m_j where ρ0_j = ρ0_i. `row` holds ρ0_i and i's distance.
+/// A pair's weight in the Laplacian row of particle i (`weight`: the coefficient of Eq. 27
+/// with its consistency correction, `laplacian_correction`) across an interface between
+/// fluids of different rest density (`interfaces`: each fluid particle's distance to the
+/// nearest one, `interface::Interfaces::distance`): row i is then ρ0_i ∇·(∇P/ρ), with 1/ρ̄_ij
+/// across a pair, ρ̄_ij the density along the segment between them (`interface::pair_weight`),
+/// which keeps ∇P/ρ continuous across the interface and a stable layering at rest. The whole
+/// corrected coefficient is weighted: the correction keeps the row exact for a field whose
+/// weighted differences are linear, the hydrostatic pressure of a layering, also where a wall
+/// or the surface truncates the support (with the coefficient alone weighted, the layering
+/// moved where its interface meets a side wall). A wall ghost is one of i's own fluid
+/// (`volume_mass`). `row` holds ρ0_i and i's distance.
 #[inline(always)]
-fn laplacian_mass<const D: usize>(
+fn across_interfaces<const D: usize>(
     p: &Particles<D>,
     interfaces: Option<&[f64]>,
     row: &RowDensity,
     l: &Lanes<D>,
+    weight: F64s,
 ) -> F64s {
-    let mass = volume_mass(p, interfaces.is_some(), row, l);
     match (interfaces, l.kind) {
         (Some(distance), Kind::Fluid) => {
-            let weight = pair_weight(
-                row.rest_density,
-                l.load(&p.rest_density),
-                row.distance,
-                l.load(distance),
-            );
-            mass * weight
+            let rest_density = l.load(&p.rest_density);
+            weight
+                * pair_weight(
+                    row.rest_density,
+                    rest_density,
+                    row.distance,
+                    l.load(distance),
+                )
         }
-        _ => mass,
+        _ => weight,
     }
 }
 
@@ -397,7 +401,7 @@ fn laplacian_correction<const D: usize>(
     nb.for_each_lanes(i, |lanes| {
         let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(lanes.r);
         // −a_ij of Eq. (27) (`sph::laplacian_coefficient`) for the kernel's truncation alone:
-        // across an interface the pairs are weighted by design (`laplacian_mass`), and taken
+        // across an interface the pairs are weighted by design (`across_interfaces`), and taken
         // for truncation that weighting would be undone, leaving one fluid's pressure gradient
         // through both.
         let mass = volume_mass(p, interfaces.is_some(), &row, lanes);
@@ -430,7 +434,7 @@ pub struct PressureOperator<'a, const D: usize> {
     /// The gravity the wall ghosts' pressures carry (`StepSettings::ghost_gravity`).
     pub ghost_gravity: [f64; D],
     /// Where the fluids differ in rest density, each fluid particle's distance to the nearest
-    /// interface (`laplacian_mass`).
+    /// interface (`across_interfaces`).
     pub interfaces: Option<&'a [f64]>,
 }
 
@@ -451,16 +455,19 @@ impl<const D: usize> PressureOperator<'_, D> {
     }
 
     /// Weights of (P_i − P_j) in the interior row i (constants `row`) for the lanes `l`, with
-    /// `mass` and `volume` the masses m̃_j (`laplacian_mass`) and volumes V_j of the lanes:
-    /// max(a_ij − V_j ĉ_i·∇W_ij, 0), a_ij = −(2 m̃_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27).
+    /// `volume` the volumes V_j of the lanes: max(a_ij − V_j ĉ_i·∇W_ij, 0),
+    /// a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27) (m_j = ρ0_i V_j where the
+    /// fluids differ: `volume_mass`), weighted across an interface (`across_interfaces`).
     #[inline(always)]
-    fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, mass: F64s, volume: F64s) -> F64s {
-        // a_ij − V_j F ĉ_i·r_ij = k ((−2 m̃_j/ρ_i) r² − V_j (r² + η²) ĉ_i·r_ij), with
+    fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, volume: F64s) -> F64s {
+        let mass = volume_mass(self.p, self.interfaces.is_some(), &row.density, l);
+        // a_ij − V_j F ĉ_i·r_ij = k ((−2 m_j/ρ_i) r² − V_j (r² + η²) ĉ_i·r_ij), with
         // F = k (r² + η²) and the Laplacian factor k r² (`RadialTerms`).
         let radial = self.nb.radial_terms_lanes(l.r);
         let c_r = (0..D).fold(F64s::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
         let correction = volume * radial.r2_eta2 * c_r;
         let weight = radial.k * (row.scale * mass).mul_add(radial.r2, -correction);
+        let weight = across_interfaces(self.p, self.interfaces, &row.density, l, weight);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
@@ -470,8 +477,7 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// The weights of interior row i with its fluid neighbours `l`.
     #[inline(always)]
     fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> F64s {
-        let mass = laplacian_mass(self.p, self.interfaces, &row.density, l);
-        self.interior_weights(row, l, mass, l.load(self.fluid_volume))
+        self.interior_weights(row, l, l.load(self.fluid_volume))
     }
 
     /// The wall part of the right-hand side of interior row i: the Neumann ghosts' known
@@ -481,8 +487,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         let mut b = Sum::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
             let volume = l.load(&p.mass) / l.load(&p.rest_density);
-            let mass = laplacian_mass(p, self.interfaces, &row.density, l);
-            let w = self.interior_weights(&row, l, mass, volume);
+            let w = self.interior_weights(&row, l, volume);
             b += w * ghost_pressure_difference(p, self.ghost_gravity, i, l);
         });
         b.total()

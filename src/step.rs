@@ -724,7 +724,7 @@ fn pressure_operator<'a, const D: usize>(
 }
 
 /// `distance`, each fluid particle's distance to the nearest interface, where the fluids
-/// differ in rest density (`table`; `ppe::laplacian_mass`).
+/// differ in rest density (`table`; `ppe::across_interfaces`).
 fn interfaces<'a>(table: &Option<Interfaces>, distance: &'a [f64]) -> Option<&'a [f64]> {
     table.as_ref().map(|_| distance)
 }
