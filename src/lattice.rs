@@ -4,7 +4,7 @@
 use crate::faces::Faces;
 use crate::kernel::SUPPORT_IN_H;
 use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
-use crate::scene::{Aabb, Scene};
+use crate::scene::{Aabb, Block, Scene};
 
 /// Number of dummy wall layers that fill the kernel support 3h.
 pub fn wall_layers(scene: &Scene) -> usize {
@@ -42,11 +42,9 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let near_obstacle = |x: &[f64; D]| near_obstacle(scene, x);
 
     let mut particles = Particles::<D>::default();
-    // A lattice point belongs to the first block that contains it.
     for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
         let x = point(k);
-        let block = scene.blocks.iter().find(|b| b.region.contains(&x));
-        if let (Some(b), false) = (block, near_obstacle(&x)) {
+        if let (Some(b), false) = (block_of(scene, &x), near_obstacle(&x)) {
             let fluid = &scene.fluids[b.fluid];
             particles.push(NewParticle {
                 pos: x,
@@ -96,6 +94,36 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
         }
     });
     particles
+}
+
+/// The block lattice point x belongs to: the first that holds it strictly inside. A point on
+/// a block's face (within 1e-9 dx) belongs to the first block whose face it lies on when the
+/// blocks cover more than half of its cell (counted at the centres of its 2^D sub-cells): two
+/// blocks stacked on a face through a lattice plane leave no empty layer between them (which
+/// fell in, or took a whole plane of fluid for free surface), while the face of a lone block
+/// keeps its points out, as half their cell lies outside.
+fn block_of<'a, const D: usize>(scene: &'a Scene, x: &[f64; D]) -> Option<&'a Block> {
+    let blocks = &scene.blocks;
+    if let Some(b) = blocks.iter().find(|b| b.region.contains(x)) {
+        return Some(b);
+    }
+    let on_face = blocks
+        .iter()
+        .find(|b| b.region.contains_within(x, 1e-9 * scene.spacing))?;
+    let quarter = 0.25 * scene.spacing;
+    let covered = (0..1usize << D)
+        .filter(|corner| {
+            let probe: [f64; D] = std::array::from_fn(|d| {
+                x[d] + if corner >> d & 1 == 1 {
+                    quarter
+                } else {
+                    -quarter
+                }
+            });
+            blocks.iter().any(|b| b.region.contains(&probe))
+        })
+        .count();
+    (2 * covered > 1 << D).then_some(on_face)
 }
 
 /// Whether the fluid fills the container: every lattice point inside it and outside the
