@@ -16,11 +16,12 @@
 //!    eigenvector of λ_i, the direction in which the support is emptiest. A particle inside a
 //!    gap of the fluid or squeezed against a wall has a neighbour in every umbrella; one on
 //!    the surface has none in at least one.
-//! 3. A particle whose summation density is below 0.9 ρ0 (at h/dx = 1.2, scaled with the
-//!    kernel's reach: `spray_density`) is free surface whatever λ_i says: spray — loose particles at a breaking front or an impact, each with some neighbour in
-//!    every umbrella but no fluid around it — and sparse fluid beside a wall, whose wall
-//!    particles fill the moment matrix. A Laplacian row there sees a few neighbours converging
-//!    at impact speed and answers with a pressure spike that blows the spray apart.
+//! 3. A particle whose summation density is below 0.9 ρ0 (at h/dx = 1.2, scaled with the kernel's
+//!    reach: `spray_density`) is free surface whatever λ_i says: spray — loose particles at a
+//!    breaking front or an impact, each with some neighbour in every umbrella but no fluid around
+//!    it — and sparse fluid beside a wall, whose wall particles fill the moment matrix. A Laplacian
+//!    row there sees a few neighbours converging at impact speed and answers with a pressure spike
+//!    that blows the spray apart.
 //! 4. A particle whose summation density exceeds ρ0 is never free surface, whatever the other
 //!    rules say: a truncated support holds less mass than a full one, so one that holds more
 //!    is compressed, and a free-surface row (a fixed pressure) cannot push back. At the tip of

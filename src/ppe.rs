@@ -377,17 +377,16 @@ impl RowDensity {
 }
 
 /// First-order consistency of the Laplacian of Eq. (27). Where the free surface truncates the
-/// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with
-/// c_i = 2 Σ_j (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support; every
-/// neighbour counted as one of i's own fluid, m_j = ρ0_i V_j, where the fluids differ). A wall ghost
-/// continues only the normal part of the field, so a wall neighbour contributes N_b r_ij (see
-/// `wall`): beside a plane wall the wall supplies what the missing fluid would, but in a corner
-/// or where the surface meets a wall the support is truncated for the tangential part too.
-/// Subtracting that term, with ∇P_i the corrected gradient
-/// L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij − V_j (L_iᵀc_i)·∇W_ij)(P_i − P_j),
-/// still one pass over the neighbours. Without it the pressure bends under the free surface and
-/// pushes a still surface off its rest position. Returns ĉ_i = L_iᵀ c_i, with L_i the
-/// pressure gradient correction.
+/// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with c_i = 2 Σ_j
+/// (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support; every neighbour counted as one
+/// of i's own fluid, m_j = ρ0_i V_j, where the fluids differ). A wall ghost continues only the
+/// normal part of the field, so a wall neighbour contributes N_b r_ij (see `wall`): beside a plane
+/// wall the wall supplies what the missing fluid would, but in a corner or where the surface meets
+/// a wall the support is truncated for the tangential part too. Subtracting that term, with ∇P_i
+/// the corrected gradient L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij − V_j
+/// (L_iᵀc_i)·∇W_ij)(P_i − P_j), still one pass over the neighbours. Without it the pressure bends
+/// under the free surface and pushes a still surface off its rest position. Returns ĉ_i = L_iᵀ c_i,
+/// with L_i the pressure gradient correction.
 fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,

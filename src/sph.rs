@@ -9,8 +9,9 @@ use crate::wall::{behind_walls, ghost_velocity, Face};
 
 /// Summation density ρ_i = Σ_j m_j (ρ0_i/ρ0_j) W_ij = ρ0_i Σ_j V_j W_ij (self included): the
 /// familiar Σ_j m_j W_ij where the support holds one fluid, while across the interface of two
-/// fluids each neighbour counts with its volume (Hu & Adams 2006), so that water beside oil
-/// is not taken for expanded (below 0.9 ρ0 it would be spray: `free_surface::spray_density`) nor the oil for compressed.
+/// fluids each neighbour counts with its volume (Hu & Adams 2006), so that water beside oil is not
+/// taken for expanded (below 0.9 ρ0 it would be spray: `free_surface::spray_density`) nor the oil
+/// for compressed.
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
     let mut rho = Sum::ZERO;
     let rho0_i = F64s::splat(p.rest_density[i]);
