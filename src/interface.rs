@@ -10,13 +10,13 @@
 //! (3.6 spacings at h/dx = 1.2) holds pairs crossing it anywhere along their length. With
 //! f = ½ a stable layering of a fluid at half the water's density over water reached 0.19 m/s
 //! in 0.6 s where this one stays at 0.03 (`tests/hydrostatic.rs`; `ppe::laplacian_correction`
-//! and `ppe::across_interfaces` for the other half of that fix). The fraction comes from each
+//! and `PressureOperator::interior_weights` for the other half of that fix). The fraction comes from each
 //! particle's distance to the interface along the normal, d_i (`Interfaces::distance`):
 //! f = d_i/(d_i + d_j), whatever the pair's direction.
 
 use crate::kernel::Quintic;
 use crate::lanes::F64s;
-use crate::neighbours::Neighbours;
+use crate::neighbours::{Lanes, Neighbours};
 use crate::particles::{Kind, Particles};
 
 /// Intervals of the table of `Interfaces` over [0, 3h].
@@ -125,4 +125,44 @@ pub fn pair_weight(
         .simd_gt(F64s::ZERO)
         .select(distance_i / sum, F64s::splat(0.5));
     rest_density_i / f.mul_add(rest_density_i - rest_density_j, rest_density_j)
+}
+
+/// Particle i's side of its pairs across interfaces, in lanes: ρ0_i and i's distance to the
+/// nearest interface (0 where the fluids share one rest density).
+#[derive(Clone, Copy, Debug)]
+pub struct Side {
+    pub rest_density: F64s,
+    distance: F64s,
+}
+
+impl Side {
+    /// Particle i's side, with `distances` each fluid particle's distance to the nearest
+    /// interface where the fluids differ in rest density (`Interfaces::distance`).
+    pub fn of<const D: usize>(p: &Particles<D>, distances: Option<&[f64]>, i: usize) -> Self {
+        Self {
+            rest_density: F64s::splat(p.rest_density[i]),
+            distance: F64s::splat(distances.map_or(0.0, |d| d[i])),
+        }
+    }
+
+    /// `value`, a term of the pairs of i with the lanes `l`, weighted by ρ0_i/ρ̄_ij
+    /// (`pair_weight`) where the fluids differ in rest density (`distances`); unchanged where
+    /// they share one and for wall lanes (a wall ghost is one of i's own fluid).
+    #[inline(always)]
+    pub fn across<const D: usize>(
+        &self,
+        p: &Particles<D>,
+        distances: Option<&[f64]>,
+        l: &Lanes<D>,
+        value: F64s,
+    ) -> F64s {
+        match (distances, l.kind) {
+            (Some(distance), Kind::Fluid) => {
+                let rest_density = l.load(&p.rest_density);
+                let distance_j = l.load(distance);
+                value * pair_weight(self.rest_density, rest_density, self.distance, distance_j)
+            }
+            _ => value,
+        }
+    }
 }

@@ -15,7 +15,7 @@
 //! first in the sorted order).
 
 use crate::free_surface::Support;
-use crate::interface::pair_weight;
+use crate::interface::Side;
 use crate::lanes::{F64s, Sum, LANES};
 use crate::linsolve::LinearOperator;
 use crate::multigrid::{stencil_slot, Aggregated};
@@ -310,69 +310,19 @@ fn divergence_source<const D: usize>(
     -(rho0 / dt * div + density_term)
 }
 
-/// A pair's weight in the Laplacian row of particle i (`weight`: the coefficient of Eq. 27
-/// with its consistency correction, `laplacian_correction`) across an interface between
-/// fluids of different rest density (`interfaces`: each fluid particle's distance to the
-/// nearest one, `interface::Interfaces::distance`): row i is then ρ0_i ∇·(∇P/ρ), with 1/ρ̄_ij
-/// across a pair, ρ̄_ij the density along the segment between them (`interface::pair_weight`),
-/// which keeps ∇P/ρ continuous across the interface and a stable layering at rest. The whole
-/// corrected coefficient is weighted: the correction keeps the row exact for a field whose
-/// weighted differences are linear, the hydrostatic pressure of a layering, also where a wall
-/// or the surface truncates the support (with the coefficient alone weighted, the layering
-/// moved where its interface meets a side wall). A wall ghost is one of i's own fluid
-/// (`volume_mass`). `row` holds ρ0_i and i's distance.
-#[inline(always)]
-fn across_interfaces<const D: usize>(
-    p: &Particles<D>,
-    interfaces: Option<&[f64]>,
-    row: &RowDensity,
-    l: &Lanes<D>,
-    weight: F64s,
-) -> F64s {
-    match (interfaces, l.kind) {
-        (Some(distance), Kind::Fluid) => {
-            let rest_density = l.load(&p.rest_density);
-            weight
-                * pair_weight(
-                    row.rest_density,
-                    rest_density,
-                    row.distance,
-                    l.load(distance),
-                )
-        }
-        _ => weight,
-    }
-}
-
 /// ρ0_i V_j, the mass of neighbour j's volume at i's rest density: m_j where the fluids share
 /// one (`interfaces` false), every neighbour counted as one of i's own fluid where they do not.
 #[inline(always)]
 fn volume_mass<const D: usize>(
     p: &Particles<D>,
     interfaces: bool,
-    row: &RowDensity,
+    row: &Side,
     l: &Lanes<D>,
 ) -> F64s {
     if interfaces {
         mass_at_density(p, row.rest_density, l)
     } else {
         l.load(&p.mass)
-    }
-}
-
-/// ρ0_i and particle i's distance to the nearest interface (0 without interfaces), in lanes.
-#[derive(Clone, Copy, Debug)]
-struct RowDensity {
-    rest_density: F64s,
-    distance: F64s,
-}
-
-impl RowDensity {
-    fn of<const D: usize>(p: &Particles<D>, interfaces: Option<&[f64]>, i: usize) -> Self {
-        Self {
-            rest_density: F64s::splat(p.rest_density[i]),
-            distance: F64s::splat(interfaces.map_or(0.0, |d| d[i])),
-        }
     }
 }
 
@@ -396,11 +346,11 @@ fn laplacian_correction<const D: usize>(
 ) -> [f64; D] {
     let mut c = [Sum::ZERO; D];
     let scale = F64s::splat(2.0 / p.rest_density[i]);
-    let row = RowDensity::of(p, interfaces, i);
+    let row = Side::of(p, interfaces, i);
     nb.for_each_lanes(i, |lanes| {
         let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(lanes.r);
         // −a_ij of Eq. (27) (`sph::laplacian_coefficient`) for the kernel's truncation alone:
-        // across an interface the pairs are weighted by design (`across_interfaces`), and taken
+        // across an interface the pairs are weighted by design (`interior_weights`), and taken
         // for truncation that weighting would be undone, leaving one fluid's pressure gradient
         // through both.
         let mass = volume_mass(p, interfaces.is_some(), &row, lanes);
@@ -433,7 +383,7 @@ pub struct PressureOperator<'a, const D: usize> {
     /// The gravity the wall ghosts' pressures carry (`StepSettings::ghost_gravity`).
     pub ghost_gravity: [f64; D],
     /// Where the fluids differ in rest density, each fluid particle's distance to the nearest
-    /// interface (`across_interfaces`).
+    /// interface (`interior_weights`).
     pub interfaces: Option<&'a [f64]>,
 }
 
@@ -441,7 +391,8 @@ pub struct PressureOperator<'a, const D: usize> {
 struct Row<const D: usize> {
     scale: F64s,
     c: [F64s; D],
-    density: RowDensity,
+    /// ρ0_i and i's distance to the nearest interface.
+    density: Side,
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
@@ -449,14 +400,21 @@ impl<const D: usize> PressureOperator<'_, D> {
         Row {
             scale: F64s::splat(-2.0 / self.p.rest_density[i]),
             c: std::array::from_fn(|d| F64s::splat(self.row_vectors[d][i])),
-            density: RowDensity::of(self.p, self.interfaces, i),
+            density: Side::of(self.p, self.interfaces, i),
         }
     }
 
     /// Weights of (P_i − P_j) in the interior row i (constants `row`) for the lanes `l`, with
     /// `volume` the volumes V_j of the lanes: max(a_ij − V_j ĉ_i·∇W_ij, 0),
     /// a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27) (m_j = ρ0_i V_j where the
-    /// fluids differ: `volume_mass`), weighted across an interface (`across_interfaces`).
+    /// fluids differ: `volume_mass`). Across an interface between fluids of different rest
+    /// density the row is ρ0_i ∇·(∇P/ρ), with 1/ρ̄_ij across a pair, ρ̄_ij the density along
+    /// the segment between them (`interface::pair_weight`), which keeps ∇P/ρ continuous across
+    /// the interface and a stable layering at rest. The whole corrected coefficient is
+    /// weighted: the correction keeps the row exact for a field whose weighted differences are
+    /// linear, the hydrostatic pressure of a layering, also where a wall or the surface
+    /// truncates the support (with the coefficient alone weighted, the layering moved where
+    /// its interface meets a side wall).
     #[inline(always)]
     fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, volume: F64s) -> F64s {
         let mass = volume_mass(self.p, self.interfaces.is_some(), &row.density, l);
@@ -466,7 +424,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         let c_r = (0..D).fold(F64s::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
         let correction = volume * radial.r2_eta2 * c_r;
         let weight = radial.k * (row.scale * mass).mul_add(radial.r2, -correction);
-        let weight = across_interfaces(self.p, self.interfaces, &row.density, l, weight);
+        let weight = row.density.across(self.p, self.interfaces, l, weight);
         // Where the support is badly truncated (a surge tip, spray) the correction can turn a
         // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
         // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.

@@ -503,28 +503,36 @@ impl<const D: usize> Workspace<D> {
         }
         self.pressure.resize(n, 0.0);
         let kernel_correction = set.effects.kernel_correction;
+        let interfaces = interfaces(&self.interface_table, &self.interface_distance);
         ppe::row_vectors(
             nb,
             p,
-            interfaces(&self.interface_table, &self.interface_distance),
+            interfaces,
             &self.roles,
             Corrections::new(kernel_correction, &self.pressure_corrections),
             &mut self.row_vectors,
         );
         ppe::fluid_volumes(p, n, &mut self.fluid_volume);
-        let (rows, volumes) = (&self.row_vectors, &self.fluid_volume);
-        let interfaces = interfaces(&self.interface_table, &self.interface_distance);
         // Water sealed off from the free surface (a compartment under a lid, a pocket against
         // a wall) has no pressure level of its own: its highest particle is pinned to P = 0,
         // the role the free surface plays elsewhere, and the hierarchy rebuilt (a pinned
         // region is anchored, so the second pass finds none).
         let mut sealed = Vec::new();
-        loop {
-            let op = pressure_operator(nb, p, set, &self.roles, rows, volumes, interfaces);
+        let op = loop {
+            let op = PressureOperator {
+                nb,
+                p,
+                roles: &self.roles,
+                row_vectors: &self.row_vectors,
+                fluid_volume: &self.fluid_volume,
+                gravity: set.gravity,
+                ghost_gravity: set.ghost_gravity,
+                interfaces,
+            };
             self.multigrid.setup(&op)?;
             let unanchored = self.multigrid.unanchored_regions();
             if unanchored.is_empty() {
-                break;
+                break op;
             }
             for region in &unanchored {
                 let top = ppe::highest(p, set.gravity, region.iter().copied())
@@ -532,8 +540,7 @@ impl<const D: usize> Workspace<D> {
                 self.roles[top] = Role::Reference;
             }
             sealed.extend(unanchored);
-        }
-        let op = pressure_operator(nb, p, set, &self.roles, rows, volumes, interfaces);
+        };
         ppe::source(
             &op,
             self.reference.is_some(),
@@ -586,9 +593,10 @@ impl<const D: usize> Workspace<D> {
         let touch = touching_distance(set.spacing);
         let (roles, full) = (&self.roles, &self.full_support);
         let interfaces = interfaces(&self.interface_table, &self.interface_distance);
+        let ghost = set.ghost_gravity;
         fill_vector_and_update(&mut self.velocity, &mut self.u_star, |i, u_star| {
             let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
-            let grad = pressure_gradient(nb, p, set, interfaces, corrections.of(i), p_ref, i);
+            let grad = pressure_gradient(nb, p, ghost, interfaces, corrections.of(i), p_ref, i);
             let rho0 = p.rest_density[i];
             let u = std::array::from_fn(|d| u_star[d] - dt * grad[d] / rho0);
             (faces.no_penetration(p.position(i), u, touch), grad)
@@ -701,30 +709,8 @@ impl<const D: usize> Workspace<D> {
     }
 }
 
-/// The PPE operator of the particles' `roles` (`solve_pressure`).
-fn pressure_operator<'a, const D: usize>(
-    nb: &'a Neighbours<'a, D>,
-    p: &'a Particles<D>,
-    set: &StepSettings<D>,
-    roles: &'a [Role],
-    row_vectors: &'a [Vec<f64>; D],
-    fluid_volume: &'a [f64],
-    interfaces: Option<&'a [f64]>,
-) -> PressureOperator<'a, D> {
-    PressureOperator {
-        nb,
-        p,
-        roles,
-        row_vectors,
-        fluid_volume,
-        gravity: set.gravity,
-        ghost_gravity: set.ghost_gravity,
-        interfaces,
-    }
-}
-
 /// `distance`, each fluid particle's distance to the nearest interface, where the fluids
-/// differ in rest density (`table`; `ppe::across_interfaces`).
+/// differ in rest density (`table`; `interface::Side::across`).
 fn interfaces<'a>(table: &Option<Interfaces>, distance: &'a [f64]) -> Option<&'a [f64]> {
     table.as_ref().map(|_| distance)
 }
@@ -763,39 +749,24 @@ fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
 
 /// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25), the differences
 /// taken from `p_ref` (`pressure_reference`), and the walls as ghosts of P_i (see `wall`)
-/// carrying `set.ghost_gravity`: a particle whose pressure exceeds p_ref is pushed off a wall it
+/// carrying `ghost_gravity`: a particle whose pressure exceeds p_ref is pushed off a wall it
 /// presses on, but not out through a free surface; across the interface of two fluids
 /// (`interfaces`, the distances to it) each difference is weighted by ρ0_i/ρ̄_ij
-/// (`interface::pair_weight`).
+/// (`interface::Side::across`).
 fn pressure_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    set: &StepSettings<D>,
+    ghost_gravity: [f64; D],
     interfaces: Option<&[f64]>,
     l: &Correction<D>,
     p_ref: f64,
     i: usize,
 ) -> [f64; D] {
-    let (p_ref, rest_density) = (F64s::splat(p_ref), F64s::splat(p.rest_density[i]));
+    let (p_ref, side) = (F64s::splat(p_ref), interface::Side::of(p, interfaces, i));
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
     let own = F64s::splat(p.pressure[i]) - p_ref;
-    let ghost_gravity = set.ghost_gravity;
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
-        Kind::Fluid => {
-            let difference = lanes.load(&p.pressure) - p_ref;
-            match interfaces {
-                Some(distance) => {
-                    let weight = interface::pair_weight(
-                        rest_density,
-                        lanes.load(&p.rest_density),
-                        F64s::splat(distance[i]),
-                        lanes.load(distance),
-                    );
-                    difference * weight
-                }
-                None => difference,
-            }
-        }
+        Kind::Fluid => side.across(p, interfaces, lanes, lanes.load(&p.pressure) - p_ref),
         Kind::Wall => own + wall::ghost_pressure_difference(p, ghost_gravity, i, lanes),
     })
 }
