@@ -526,7 +526,7 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
                 // its diagonal), which only weakens the preconditioner near that boundary.
                 let block_j = block(j);
                 let offset: [i64; D] = std::array::from_fn(|d| block_j[d] - block_i[d]);
-                if self.aggregate(j).is_some() && offset.iter().all(|o| o.abs() <= 1) {
+                if self.roles[j] == Role::Interior && offset.iter().all(|o| o.abs() <= 1) {
                     row[stencil_slot(offset)] -= w;
                 }
             }
