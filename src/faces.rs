@@ -66,6 +66,25 @@ impl Faces {
         unit(n)
     }
 
+    /// Per axis, the coordinate of the container's face within `reach` of x (the nearer of the
+    /// two), None along a periodic axis or where neither is that near: the planes the wall
+    /// particles behind them mirror the fluid across.
+    pub fn container_faces_within<const D: usize>(
+        &self,
+        x: [f64; D],
+        reach: f64,
+    ) -> [Option<f64>; D] {
+        let c = &self.container;
+        std::array::from_fn(|d| {
+            let (low, high) = (x[d] - c.min[d], c.max[d] - x[d]);
+            match self.periodic[d] {
+                true => None,
+                false if low <= high => (low < reach).then_some(c.min[d]),
+                false => (high < reach).then_some(c.max[d]),
+            }
+        })
+    }
+
     /// The kinematic wall condition v·n ≥ 0 for a velocity or displacement v of a fluid
     /// particle at x, for every face within `reach` of it, n the face's normal into the fluid:
     /// v ← v − min(v·n, 0) n. Near an obstacle n points from its nearest point to x (out of a

@@ -205,7 +205,7 @@ impl<const D: usize> Workspace<D> {
             };
             self.summation_density(&nb, p, nf);
             p.density[..nf].copy_from_slice(&self.density);
-            self.interface_distances(&nb, p, nf);
+            self.interface_distances(&nb, p, faces, nf);
             lap(Stage::Density);
             self.classify(&nb, p, set, nf);
             lap(Stage::FreeSurface);
@@ -351,13 +351,21 @@ impl<const D: usize> Workspace<D> {
 
     /// Each of the `nf` fluid particles' distance to the nearest interface between fluids of
     /// different rest density (`interface`), where they differ.
-    fn interface_distances(&mut self, nb: &Neighbours<D>, p: &Particles<D>, nf: usize) {
+    fn interface_distances(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        faces: &Faces,
+        nf: usize,
+    ) {
         let Some(table) = &self.interface_table else {
             return;
         };
+        let support = nb.kernel.support();
         self.interface_distance.resize(nf, 0.0);
         fill(&mut self.interface_distance, |i| {
-            table.distance(interface::other_fluid_fraction(nb, p, i))
+            let mirrors = faces.container_faces_within(p.position(i), support);
+            table.distance(interface::other_fluid_fraction(nb, p, mirrors, i))
         });
     }
 
