@@ -15,7 +15,7 @@
 //! first in the sorted order).
 
 use crate::free_surface::Support;
-use crate::interface::Side;
+use crate::interface::{Field, Side};
 use crate::lanes::{F64s, Sum, LANES};
 use crate::linsolve::LinearOperator;
 use crate::multigrid::{stencil_slot, Aggregated};
@@ -152,7 +152,7 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 pub fn row_vectors<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    interfaces: Option<&[f64]>,
+    interfaces: Option<Field<D>>,
     roles: &[Role],
     pressure_corrections: Corrections<D>,
     out: &mut [Vec<f64>; D],
@@ -316,7 +316,7 @@ fn divergence_source<const D: usize>(
 fn volume_mass<const D: usize>(
     p: &Particles<D>,
     interfaces: bool,
-    row: &Side,
+    row: &Side<D>,
     l: &Lanes<D>,
 ) -> F64s {
     if interfaces {
@@ -340,7 +340,7 @@ fn volume_mass<const D: usize>(
 fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    interfaces: Option<&[f64]>,
+    interfaces: Option<Field<D>>,
     l: &Correction<D>,
     i: usize,
 ) -> [f64; D] {
@@ -384,7 +384,7 @@ pub struct PressureOperator<'a, const D: usize> {
     pub ghost_gravity: [f64; D],
     /// Where the fluids differ in rest density, each fluid particle's distance to the nearest
     /// interface (`interior_weights`).
-    pub interfaces: Option<&'a [f64]>,
+    pub interfaces: Option<Field<'a, D>>,
 }
 
 /// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
@@ -392,7 +392,7 @@ struct Row<const D: usize> {
     scale: F64s,
     c: [F64s; D],
     /// ρ0_i and i's distance to the nearest interface.
-    density: Side,
+    density: Side<D>,
 }
 
 impl<const D: usize> PressureOperator<'_, D> {

@@ -107,6 +107,30 @@ pub fn fill_vector_and_update<const D: usize>(
         });
 }
 
+/// (s[i], v[i]) ← f(i) for every i: a scalar and a vector per particle from one pass, the
+/// vector into the SoA components of `v`.
+pub fn fill_scalar_and_vector<const D: usize>(
+    s: &mut [f64],
+    v: &mut [Vec<f64>; D],
+    f: impl Fn(usize) -> (f64, [f64; D]) + Sync,
+) {
+    assert_eq!(
+        s.len(),
+        v[0].len(),
+        "one scalar and one vector per particle"
+    );
+    s.par_chunks_mut(BLOCK)
+        .zip(component_blocks(v))
+        .enumerate()
+        .for_each(|(c, (block_s, mut block_v))| {
+            for k in 0..block_s.len() {
+                let (x, y) = f(c * BLOCK + k);
+                block_s[k] = x;
+                set(&mut block_v, k, y);
+            }
+        });
+}
+
 /// The SoA components of `out` in blocks of `BLOCK` particles: block c holds particles
 /// c·BLOCK … of every component.
 fn component_blocks<const D: usize>(out: &mut [Vec<f64>; D]) -> Vec<[&mut [f64]; D]> {

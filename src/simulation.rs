@@ -144,7 +144,7 @@ impl<const D: usize> Simulation<D> {
                     .fluids
                     .iter()
                     .any(|f| f.density != scene.fluids[0].density)
-                    .then(|| Interfaces::new(&Quintic::<D>::new(h))),
+                    .then(|| Interfaces::new(&Quintic::<D>::new(h), scene.spacing)),
             ),
             timings: Timings::default(),
         })

@@ -21,12 +21,13 @@ use crate::multigrid::Multigrid;
 use crate::neighbours::Lanes;
 use crate::particles::{components, Kind, Particles};
 use crate::ppe::{self, PressureOperator, Role};
-use crate::reduce::{self, fill, fill_vector, fill_vector_and_update};
+use crate::reduce::{self, fill, fill_scalar_and_vector, fill_vector, fill_vector_and_update};
 use crate::scene::Effects;
 use crate::shifting::{Shifting, ShiftingSettings};
 use crate::sph::{self, Correction, Corrections, Neighbours, NO_SLOT};
 use crate::timings::{Stage, Timings};
 use crate::turbulence::{self, LesSettings};
+use crate::vector::unit;
 use crate::wall;
 use rayon::iter::Either;
 use rayon::prelude::*;
@@ -100,10 +101,11 @@ pub struct Workspace<const D: usize> {
     /// Summation density of the step (swapped into the particles).
     density: Vec<f64>,
     /// Where the fluids differ in rest density, the kernel's table of distances to an
-    /// interface (`interface`), and each fluid particle's distance to the nearest one: the
-    /// PPE rows and the pressure gradient weigh the pairs across it.
+    /// interface (`interface`), and each fluid particle's distance to the nearest one and
+    /// normal across it: the PPE rows and the pressure gradient weigh the pairs across it.
     interface_table: Option<Interfaces>,
     interface_distance: Vec<f64>,
+    interface_normal: [Vec<f64>; D],
     /// The free surface's outward normal of each fluid particle, where shifting keeps to the
     /// tangential direction (with shifting).
     surface_normal: Vec<[f64; D]>,
@@ -148,6 +150,7 @@ impl<const D: usize> Workspace<D> {
             density: Vec::new(),
             interface_table: interfaces,
             interface_distance: Vec::new(),
+            interface_normal: components(),
             surface_normal: Vec::new(),
             roles: Vec::new(),
             reference: None,
@@ -264,6 +267,7 @@ impl<const D: usize> Workspace<D> {
             density,
             interface_table,
             interface_distance,
+            interface_normal,
             surface_normal,
             roles,
             reference: _,
@@ -333,6 +337,8 @@ impl<const D: usize> Workspace<D> {
         if interface_table.is_some() {
             let distance = ArraySize::of("interface distance", interface_distance);
             arrays.push((Stage::Density, distance));
+            let normal = ArraySize::of_components("interface normal", interface_normal);
+            arrays.push((Stage::Density, normal));
         }
         // Every array of the workspace holds the fluid particles only (see the module doc).
         for (_, a) in &mut arrays {
@@ -363,10 +369,18 @@ impl<const D: usize> Workspace<D> {
         };
         let support = nb.kernel.support();
         self.interface_distance.resize(nf, 0.0);
-        fill(&mut self.interface_distance, |i| {
-            let mirrors = faces.container_faces_within(p.position(i), support);
-            table.distance(interface::other_fluid_fraction(nb, p, mirrors, i))
-        });
+        for n in &mut self.interface_normal {
+            n.resize(nf, 0.0);
+        }
+        fill_scalar_and_vector(
+            &mut self.interface_distance,
+            &mut self.interface_normal,
+            |i| {
+                let mirrors = faces.container_faces_within(p.position(i), support);
+                let (share, gradient) = interface::other_fluid_share(nb, p, mirrors, i);
+                (table.distance(share), unit(gradient))
+            },
+        );
     }
 
     /// How each support is filled, from its moments (`sph::support_moments`): the free surface
@@ -511,7 +525,11 @@ impl<const D: usize> Workspace<D> {
         }
         self.pressure.resize(n, 0.0);
         let kernel_correction = set.effects.kernel_correction;
-        let interfaces = interfaces(&self.interface_table, &self.interface_distance);
+        let interfaces = interfaces(
+            &self.interface_table,
+            &self.interface_distance,
+            &self.interface_normal,
+        );
         ppe::row_vectors(
             nb,
             p,
@@ -600,7 +618,11 @@ impl<const D: usize> Workspace<D> {
             Corrections::new(set.effects.kernel_correction, &self.pressure_corrections);
         let touch = touching_distance(set.spacing);
         let (roles, full) = (&self.roles, &self.full_support);
-        let interfaces = interfaces(&self.interface_table, &self.interface_distance);
+        let interfaces = interfaces(
+            &self.interface_table,
+            &self.interface_distance,
+            &self.interface_normal,
+        );
         let ghost = set.ghost_gravity;
         fill_vector_and_update(&mut self.velocity, &mut self.u_star, |i, u_star| {
             let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
@@ -717,10 +739,16 @@ impl<const D: usize> Workspace<D> {
     }
 }
 
-/// `distance`, each fluid particle's distance to the nearest interface, where the fluids
-/// differ in rest density (`table`; `interface::Side::across`).
-fn interfaces<'a>(table: &Option<Interfaces>, distance: &'a [f64]) -> Option<&'a [f64]> {
-    table.as_ref().map(|_| distance)
+/// The interfaces' distances and normals, where the fluids differ in rest density (`table`;
+/// `interface::Side::across`).
+fn interfaces<'a, const D: usize>(
+    table: &Option<Interfaces>,
+    distance: &'a [f64],
+    normal: &'a [Vec<f64>; D],
+) -> Option<interface::Field<'a, D>> {
+    table
+        .as_ref()
+        .map(|_| interface::Field { distance, normal })
 }
 
 /// The pressures of the wall particles (from index `nf` on), for the frames: the
@@ -765,7 +793,7 @@ fn pressure_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     ghost_gravity: [f64; D],
-    interfaces: Option<&[f64]>,
+    interfaces: Option<interface::Field<D>>,
     l: &Correction<D>,
     p_ref: f64,
     i: usize,

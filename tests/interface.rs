@@ -3,20 +3,22 @@
 
 use crate::common::Lattice;
 use isph::faces::Faces;
-use isph::interface::{other_fluid_fraction, pair_weight, Interfaces};
+use isph::interface::{other_fluid_share, pair_weight, Interfaces};
 use isph::lanes::F64s;
 use isph::particles::Kind;
 use isph::scene::Aabb;
 use isph::sph::Neighbours;
+use isph::vector::unit;
 
 const DX: f64 = 0.01;
 
 /// A block of lattice particles, those above the plane half a spacing over the middle row
 /// of twice the density: a flat interface. A particle k rows from it reads its distance off
-/// the other fluid's share of its kernel (a continuum's half space, summed over lattice
-/// points): the first row at 0.51–0.53 spacings for 0.5, farther rows in proportion, d_k/d_0
-/// within 5% of 2k + 1 as long as the other fluid lies a spacing inside the support. Only
-/// those ratios enter a pair's density (`pair_weight`).
+/// the other fluid's share of its kernel against the share a lattice beyond a plane holds
+/// (`Interfaces`): k + ½ spacings, to the table's interpolation, for every row whose other
+/// fluid lies inside the support (a continuum's half space read 0.53, 1.60 and 2.73 spacings
+/// for 0.5, 1.5 and 2.5 in 2D). The normal points straight across the interface into the other
+/// fluid.
 fn distances_on_a_lattice<const D: usize>(n: i64, h_over_dx: f64) {
     let mut lat = Lattice::<D>::part(n, DX, h_over_dx, |_| true);
     let p = &mut lat.particles;
@@ -26,46 +28,39 @@ fn distances_on_a_lattice<const D: usize>(n: i64, h_over_dx: f64) {
             p.mass[i] *= 2.0;
         }
     }
-    let table = Interfaces::new(&lat.kernel);
+    let table = Interfaces::new(&lat.kernel, DX);
     let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
     let support = 3.0 * h_over_dx;
     let reach = support.ceil() as i64;
-    // Distance in spacings, by rows from the interface (0: the two rows beside it).
-    let mut by_row: Vec<Vec<f64>> = vec![Vec::new(); reach as usize];
+    let mut checked = 0;
     for i in 0..p.len() {
         let index: Vec<i64> = (0..D).map(|d| (p.pos[d][i] / DX).round() as i64).collect();
         // Inside the block, beyond the kernel's reach from its sides.
         if index.iter().any(|c| c.abs() > n / 2 - reach) {
             continue;
         }
-        let row = if index[D - 1] <= 0 {
-            -index[D - 1]
-        } else {
-            index[D - 1] - 1
+        // Rows from the interface (0: the two rows beside it) and the way across it.
+        let (row, across) = match index[D - 1] <= 0 {
+            true => (-index[D - 1], 1.0),
+            false => (index[D - 1] - 1, -1.0),
         };
-        if row < reach {
-            by_row[row as usize]
-                .push(table.distance(other_fluid_fraction(&nb, p, [None; D], i)) / DX);
-        }
-    }
-    let first = by_row[0][0];
-    assert!(
-        (first - 0.5).abs() < 0.05,
-        "D = {D}, h/dx = {h_over_dx}: first row at {first}"
-    );
-    for (k, distances) in by_row.iter().enumerate() {
-        let expected = (2 * k + 1) as f64;
-        assert!(!distances.is_empty());
-        for d in distances {
-            if expected / 2.0 + 1.0 < support {
-                assert!(
-                    (d / first / expected - 1.0).abs() < 0.05,
-                    "D = {D}, h/dx = {h_over_dx}: row {k} at {d} spacings, {} first rows",
-                    d / first
-                );
+        // The other fluid's first row, row + 1 spacings away, inside the support.
+        if ((row + 1) as f64) < support {
+            let (share, gradient) = other_fluid_share(&nb, p, [None; D], i);
+            let distance = table.distance(share) / DX;
+            assert!(
+                (distance - (row as f64 + 0.5)).abs() < 1e-3,
+                "D = {D}, h/dx = {h_over_dx}: row {row} at {distance} spacings"
+            );
+            let normal = unit(gradient);
+            for (d, component) in normal.into_iter().enumerate() {
+                let expected = if d == D - 1 { across } else { 0.0 };
+                assert!((component - expected).abs() < 1e-12, "normal {normal:?}");
             }
+            checked += 1;
         }
     }
+    assert!(checked > 0);
 }
 
 /// The same flat interface meeting the side walls: four layers of wall particles at x ≤ −dx
@@ -104,7 +99,7 @@ fn distances_beside_side_walls<const D: usize>(n: i64) {
         periodic: vec![false; D],
         obstacles: Vec::new(),
     };
-    let table = Interfaces::new(&lat.kernel);
+    let table = Interfaces::new(&lat.kernel, DX);
     let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
     let support = lat.kernel.support();
     // Distance in spacings of the fluid particle `column` lattice points from the walls (0:
@@ -120,7 +115,7 @@ fn distances_beside_side_walls<const D: usize>(n: i64) {
             .find(|&i| (0..D).all(|d| (p.pos[d][i] - target(d)).abs() < 0.25 * DX))
             .expect("a lattice particle there");
         let mirrors = faces.container_faces_within(std::array::from_fn(|d| p.pos[d][i]), support);
-        table.distance(other_fluid_fraction(&nb, p, mirrors, i)) / DX
+        table.distance(other_fluid_share(&nb, p, mirrors, i).0) / DX
     };
     for row in 0..3 {
         let far = distance(6, row);
@@ -149,51 +144,40 @@ fn the_distance_to_a_flat_interface_is_read_off_the_kernel() {
 
 #[test]
 fn far_from_any_other_fluid_the_distance_is_the_support_and_inside_it_zero() {
-    let table = Interfaces::new(&isph::kernel::Quintic::<3>::new(0.012));
+    let table = Interfaces::new(&isph::kernel::Quintic::<3>::new(0.012), 0.01);
     assert!((table.distance(0.0) - 0.036).abs() < 1e-15);
     assert!(table.distance(0.5) < 1e-4 * 0.012);
     assert_eq!(table.distance(0.8), 0.0);
+}
+
+/// ρ0_i/ρ̄_ij for ρ0_i, ρ0_j, d_i, d_j and the length L across the interface.
+fn weight(rest_i: f64, rest_j: f64, distance_i: f64, distance_j: f64, length: f64) -> f64 {
+    let w = pair_weight(
+        F64s::splat(rest_i),
+        F64s::splat(rest_j),
+        F64s::splat(distance_i),
+        F64s::splat(distance_j),
+        F64s::splat(length),
+    )
+    .to_array();
+    assert!(w.iter().all(|&x| x == w[0]), "every lane alike");
+    w[0]
 }
 
 #[test]
 fn the_pair_density_is_exact_for_a_stable_layering_and_one_within_a_fluid() {
     // i in the light fluid half a spacing above the interface, j in the heavy one 2.5 below:
     // P_j − P_i = g (500 · 0.5 + 1000 · 2.5) dx = g · 3 dx · ρ̄, ρ̄ = 2750/3.
-    let w = pair_weight(
-        F64s::splat(500.0),
-        F64s::splat(1000.0),
-        F64s::splat(0.5),
-        F64s::splat(2.5),
-    );
     let expected = 500.0 / (2750.0 / 3.0);
-    assert!(w.to_array().iter().all(|&w| (w - expected).abs() < 1e-15));
+    assert!((weight(500.0, 1000.0, 0.5, 2.5, 3.0) - expected).abs() < 1e-15);
     // From j's side the same density: ρ0_j/ρ̄ = 1000/(2750/3).
-    let w = pair_weight(
-        F64s::splat(1000.0),
-        F64s::splat(500.0),
-        F64s::splat(2.5),
-        F64s::splat(0.5),
-    );
-    assert!(w
-        .to_array()
-        .iter()
-        .all(|&w| (w - 3000.0 / 2750.0).abs() < 1e-15));
-    // Within one fluid exactly one, and where both distances are zero the harmonic mean.
-    let one = pair_weight(
-        F64s::splat(800.0),
-        F64s::splat(800.0),
-        F64s::splat(0.3),
-        F64s::splat(1.7),
-    );
-    assert!(one.to_array().iter().all(|&w| w == 1.0));
-    let mean = pair_weight(
-        F64s::splat(500.0),
-        F64s::splat(1000.0),
-        F64s::ZERO,
-        F64s::ZERO,
-    );
-    assert!(mean
-        .to_array()
-        .iter()
-        .all(|&w| (w - 2.0 / 3.0).abs() < 1e-15));
+    assert!((weight(1000.0, 500.0, 2.5, 0.5, 3.0) - 3000.0 / 2750.0).abs() < 1e-15);
+    // Two layers closing in: each reads itself nearer than it is (0.3 and 0.5 spacings over a
+    // length of 1), and the interface is taken halfway between the two places they give it,
+    // 0.4 from i: ρ̄ = 0.4 · 500 + 0.6 · 1000.
+    assert!((weight(500.0, 1000.0, 0.3, 0.5, 1.0) - 500.0 / 800.0).abs() < 1e-15);
+    // Within one fluid exactly one; with no length across the interface the harmonic mean.
+    assert_eq!(weight(800.0, 800.0, 0.3, 1.7, 2.0), 1.0);
+    assert!((weight(500.0, 1000.0, 0.0, 0.0, 0.0) - 2.0 / 3.0).abs() < 1e-15);
+    assert!((weight(500.0, 1000.0, 0.4, 0.2, -1.0) - 2.0 / 3.0).abs() < 1e-15);
 }
