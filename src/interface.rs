@@ -9,10 +9,10 @@
 //! f = ½, exact only where the interface lies halfway between the two; the kernel's support
 //! (3.6 spacings at h/dx = 1.2) holds pairs crossing it anywhere along their length. With
 //! f = ½ a stable layering of a fluid at half the water's density over water reached 0.19 m/s
-//! in 0.6 s where this one stays at 0.03 (`tests/hydrostatic.rs`; `ppe::laplacian_correction`
-//! and `PressureOperator::interior_weights` for the other half of that fix). The fraction comes from each
-//! particle's distance to the interface along the normal, d_i (`Interfaces::distance`):
-//! f = d_i/(d_i + d_j), whatever the pair's direction.
+//! in 0.6 s where this one stays at 1e-4 (`tests/hydrostatic.rs`; `ppe::laplacian_correction`
+//! and `PressureOperator::interior_weights` for the other half of that fix). f comes from each
+//! particle's distance to the interface d_i (`Interfaces::distance`) and its normal across it
+//! (`other_fluid_share`): `pair_weight`.
 
 use crate::kernel::Quintic;
 use crate::lanes::F64s;
@@ -109,7 +109,8 @@ impl Interfaces {
 /// an interface at its height than it is (`tests/interface.rs`), and the pairs across it for
 /// the wrong density: the layerings of `tests/hydrostatic.rs` drifted along their side walls at
 /// 0.010, 0.029 and 0.069 m/s within 0.6 s (upper fluid at 800, 500 and 100 kg/m³ over water),
-/// 1.4e-4, 6.5e-4 and 7.5e-3 m/s with the images. The obstacles' faces are not mirrored.
+/// 1.4e-4, 6.5e-4 and 7.5e-3 m/s with the images (1.1e-4 with `pair_weight`'s rule as well).
+/// The obstacles' faces are not mirrored.
 pub fn other_fluid_share<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
