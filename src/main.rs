@@ -207,7 +207,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 "{}: {} steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in {}, checkpoint {}",
                 scene.name,
                 summary.steps,
-                summary.time,
+                printed(summary.time),
                 summary.wall_seconds,
                 summary.mean_ppe_iterations,
                 summary.frames.len(),
@@ -245,10 +245,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 "resumed {} at step {} (t = {} s, last Δt = {:e} s): {} more steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in all, checkpoint {}",
                 located.checkpoint.path().display(),
                 state.step,
-                state.time,
+                printed(state.time),
                 state.dt,
                 summary.steps,
-                summary.time,
+                printed(summary.time),
                 summary.wall_seconds,
                 summary.mean_ppe_iterations,
                 summary.frames.len(),
@@ -376,4 +376,10 @@ fn stop_on_signals() -> anyhow::Result<StopSignal> {
             .context("installing the SIGINT/SIGTERM handlers")?;
     }
     Ok(stop)
+}
+
+/// A simulated time for a person to read, rounded to the picosecond: a run ends on its last
+/// frame as the schedule computes it, 3 × 0.1 = 0.30000000000000004 s, printed 0.3 s.
+fn printed(time: f64) -> f64 {
+    (time * 1e12).round() / 1e12
 }

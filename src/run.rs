@@ -193,6 +193,21 @@ struct Driver<'a, const D: usize> {
     stop: StopSignal,
 }
 
+/// `time`, or the multiple k × `interval` (k ≥ 1) within `FRAME_TIME_ROUNDING` intervals of it, as the
+/// frames' schedule computes it: a run ends on the frame it lands on anyway. So a run stopped
+/// at `--until 0.3` and resumed takes the very steps of one that ran through that frame,
+/// scheduled at 3 × 0.1 = 0.30000000000000004 (landing on 0.3 itself, the steps before it
+/// differed in their last bits, and the continued run from there on).
+fn on_frame(time: f64, interval: f64) -> f64 {
+    let k = (time / interval).round();
+    let multiple = k * interval;
+    if k >= 1.0 && (multiple - time).abs() <= FRAME_TIME_ROUNDING * interval {
+        multiple
+    } else {
+        time
+    }
+}
+
 impl<'a, const D: usize> Driver<'a, D> {
     /// A driver for `sim`, fresh or continuing from `resumed`.
     fn new(
@@ -208,7 +223,7 @@ impl<'a, const D: usize> Driver<'a, D> {
         let now = Instant::now();
         let mut driver = Self {
             scene,
-            end: until.unwrap_or(scene.end_time),
+            end: on_frame(until.unwrap_or(scene.end_time), scene.output_interval),
             output,
             next_output: state.map_or(0, |s| s.next_output),
             wall_before: state.map_or(0.0, |s| s.wall_seconds),

@@ -1,7 +1,8 @@
 //! Frame times: every multiple of `output_interval` and the end time, with a multiple that
 //! rounds to within a sliver of the end time taken for the end time (11 × 0.03 =
-//! 0.32999999999999996 against 0.33), so that no step is cut to a sliver (a step of 5e-17 s
-//! blew the flow up: max speed 4e12 m/s, and the end checkpoint held that state).
+//! 0.32999999999999996 against 0.33: the run ends on the multiple), so that no step is cut to
+//! a sliver (a step of 5e-17 s blew the flow up: max speed 4e12 m/s, and the end checkpoint
+//! held that state).
 
 use crate::common::{run_scene, scene_from_text, stats_column, water_block_scene, TempDir};
 use isph::scene::Scene;
@@ -40,17 +41,11 @@ fn assert_frames(
 
 #[test]
 fn a_frame_time_that_rounds_next_to_the_end_time_is_the_end_time() {
-    let mut expected: Vec<f64> = (0..11).map(|k| k as f64 * 0.03).collect();
-    expected.push(0.33);
+    // The run ends on the scheduled frame, 11 × 0.03 = 0.32999999999999996.
+    let expected: Vec<f64> = (0..12).map(|k| k as f64 * 0.03).collect();
     assert_frames(0.33, 0.03, 0.33, &expected, 1e-4);
-    // The same past a frame: `--until` a sliver after 0.04 ends there, with no frame at 0.04.
-    assert_frames(
-        0.1,
-        0.02,
-        0.04000000000001,
-        &[0.0, 0.02, 0.04000000000001],
-        1e-4,
-    );
+    // The same past a frame: `--until` a sliver after 0.04 ends on the frame at 0.04.
+    assert_frames(0.1, 0.02, 0.04000000000001, &[0.0, 0.02, 0.04], 1e-4);
     // A run shorter than the rounding still has its frame 0 at t = 0 (and one at its end).
     assert_frames(0.1, 0.02, 1e-8, &[0.0, 1e-8], 1e-8);
 }
