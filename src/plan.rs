@@ -101,6 +101,9 @@ fn describe(stage: Stage, scene: &Scene) -> String {
         Stage::CellList => {
             "counting sort by cell (x fastest), every particle array permuted together; the runs of cells around each fluid particle, which every pair loop of the step reads instead of searching the grid (about 20 runs of 6 B per fluid particle in 3D, not in the figure)".into()
         }
+        Stage::Density if scene.fluids.iter().any(|f| f.density != scene.fluids[0].density) => {
+            "summation density ρ_i = ρ0_i Σ_j V_j W_ij (fluids of different density); each fluid particle's distance to the nearest interface and normal across it, from the other fluid's share of its kernel (the walls mirroring the fluid), for the pairs across it".into()
+        }
         Stage::Density => "summation density ρ_i = Σ_j m_j W_ij; walls keep ρ0".into(),
         Stage::FreeSurface => "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".into(),
         Stage::KernelCorrection => format!("L_i = M_i⁻¹ (Eq. 24–25) for the divergence and velocity gradients, only where the free surface is in reach and stored for those particles only ({} B each, not in the figure); L'_i for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only), inverted in the free-surface pass from its moments", sparse_correction_bytes(scene.dimensions)),
