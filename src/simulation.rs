@@ -12,6 +12,7 @@ use crate::memory::ArraySize;
 use crate::particles::Particles;
 use crate::reduce;
 use crate::scene::{GhostPressure, Scene};
+use crate::sph;
 use crate::step::{speed, StepLength, StepReport, StepSettings, Workspace};
 use crate::timings::{Stage, Timings};
 use std::time::Instant;
@@ -132,6 +133,9 @@ impl<const D: usize> Simulation<D> {
                 effects: scene.effects,
                 confined,
                 spray_density: free_surface::spray_density::<D>(scene.solver.h_over_dx),
+                min_correction_determinant: sph::min_correction_determinant::<D>(
+                    scene.solver.h_over_dx,
+                ),
             },
             faces: Faces::new(scene),
             cfl: scene.solver.cfl,

@@ -51,6 +51,9 @@ pub struct StepSettings<const D: usize> {
     pub confined: bool,
     /// ρ/ρ0 below which fluid is spray, for the scene's h/dx (`free_surface::spray_density`).
     pub spray_density: f64,
+    /// det M_i at or below which the kernel gradient correction is not applied, for the
+    /// scene's h/dx (`sph::min_correction_determinant`).
+    pub min_correction_determinant: f64,
 }
 
 /// The stages of a step of a scene with `effects`, in order: those of `Workspace::project`,
@@ -213,7 +216,7 @@ impl<const D: usize> Workspace<D> {
             self.classify(&nb, p, set, nf);
             lap(Stage::FreeSurface);
             if effects.kernel_correction {
-                self.near_surface_corrections(&nb, p);
+                self.near_surface_corrections(&nb, p, set.min_correction_determinant);
                 lap(Stage::KernelCorrection);
             }
             if let Some(les) = &effects.les {
@@ -409,7 +412,8 @@ impl<const D: usize> Workspace<D> {
             .enumerate()
             .for_each(|(i, ((role, normal), corrections))| {
                 let mo = sph::support_moments(nb, p, i);
-                let l_pressure = sph::gradient_correction(mo.m_neumann);
+                let l_pressure =
+                    sph::gradient_correction(mo.m_neumann, set.min_correction_determinant);
                 let support = Support::new(&mo.m, mo.grad_c);
                 // Fluid that fills its container has no free surface: every row is interior
                 // (a disordered patch of a periodic flow can look like a surface to the
@@ -446,7 +450,12 @@ impl<const D: usize> Workspace<D> {
     /// are given out in index order, then L_i is inverted from the moments of each. The pressure
     /// gradient keeps its correction L'_i everywhere, which inside the fluid corrects the wall
     /// ghosts' missing tangential gradient.
-    fn near_surface_corrections(&mut self, nb: &Neighbours<D>, p: &Particles<D>) {
+    fn near_surface_corrections(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        min_determinant: f64,
+    ) {
         self.correction_slot
             .resize(self.full_support.len(), NO_SLOT);
         self.corrected.clear();
@@ -463,7 +472,8 @@ impl<const D: usize> Workspace<D> {
             .par_iter_mut()
             .zip(&self.corrected)
             .for_each(|(l, &i)| {
-                *l = sph::gradient_correction(sph::support_moments(nb, p, i as usize).m);
+                let moments = sph::support_moments(nb, p, i as usize);
+                *l = sph::gradient_correction(moments.m, min_determinant);
             });
     }
 

@@ -320,3 +320,45 @@ fn blocks_stacked_on_a_lattice_plane_leave_no_empty_layer() {
         50
     );
 }
+
+/// Still water in a 3D tank (0.3 × 0.2 m, 0.2 m deep, dx = 0.02 m) at the wide end of the
+/// allowed smoothing lengths. The particle at the top of the water where two side walls meet
+/// has the most truncated support that still needs its gradient correction; with the
+/// correction's determinant threshold fixed at 0.1 (set at h/dx = 1.2) it was taken for a
+/// splash from h/dx ≈ 1.75 (its lattice determinant is 0.098 at 1.8, 0.090 at 2.0), held at
+/// P = 0, and the four corners fell at 0.18 and 0.23 m/s. Measured now, over 0.3 s: 8e-4 m/s
+/// at 1.8, 1.4e-3 at 2.0 (8e-6 at 1.2).
+#[test]
+fn still_water_in_a_3d_tank_stays_still_with_a_wide_kernel() {
+    for h_over_dx in [1.8, 2.0] {
+        let scene = scene_from_text(&format!(
+            "[simulation]\ndimensions = 3\nspacing = 0.02\nend_time = 0.3\n\
+             output_interval = 0.1\ngravity = [0.0, 0.0, -9.81]\n\
+             [[fluid]]\nname = \"water\"\ndensity = 1000.0\nviscosity = 1.0e-6\n\
+             [[fluid_block]]\nfluid = \"water\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.3, 0.2, 0.2]\n\
+             [container]\nmin = [0.0, 0.0, 0.0]\nmax = [0.3, 0.2, 0.3]\n\
+             [solver]\nh_over_dx = {h_over_dx}\n"
+        ));
+        let dir = TempDir::new(&format!("still-3d-{h_over_dx}"));
+        run_scene(&scene, dir.path(), 0.3);
+        let fastest = stats_column(dir.path(), "max_speed")
+            .into_iter()
+            .fold(0.0, f64::max);
+        assert!(
+            fastest < 5e-3,
+            "h/dx = {h_over_dx}: max speed {fastest} m/s"
+        );
+    }
+}
+
+#[test]
+fn the_correction_threshold_is_0_1_where_it_was_set_and_falls_with_the_kernel_s_reach() {
+    use isph::sph::min_correction_determinant;
+    assert_eq!(min_correction_determinant::<2>(1.2), 0.1);
+    assert_eq!(min_correction_determinant::<3>(1.2), 0.1);
+    // The 3D lattice corner's determinant at h/dx = 1.5 and 2.0: the threshold stays below it.
+    for (h_over_dx, corner) in [(1.5, 0.116), (2.0, 0.090)] {
+        assert!(min_correction_determinant::<2>(h_over_dx) < 0.1);
+        assert!(min_correction_determinant::<3>(h_over_dx) < corner);
+    }
+}
