@@ -219,6 +219,10 @@ impl<const D: usize> Side<D> {
         match (field, l.kind) {
             (Some(field), Kind::Fluid) => {
                 let rest_density = l.load(&p.rest_density);
+                if rest_density.simd_eq(self.rest_density).all() {
+                    // Within one fluid the weight is exactly 1.
+                    return value;
+                }
                 let distance_j = l.load(field.distance);
                 let length = (0..D).fold(F64s::ZERO, |s, d| {
                     (l.load(&field.normal[d]) - self.normal[d]).mul_add(l.rij[d], s)
