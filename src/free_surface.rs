@@ -30,6 +30,7 @@
 //!    and shot it out at 2.8 m/s, 35% faster than the front (2.1 m/s with this rule).
 
 use crate::kernel::Quintic;
+use crate::lattice::for_each_lattice_point;
 use crate::sph::Neighbours;
 use crate::vector::{dot, norm};
 
@@ -64,15 +65,13 @@ pub fn spray_density<const D: usize>(h_over_dx: f64) -> f64 {
 fn second_corner_density<const D: usize>(h_over_dx: f64) -> f64 {
     let kernel = Quintic::<D>::new(h_over_dx);
     let reach = kernel.support().ceil() as i64;
-    let span = 2 * reach + 1;
     let mut sum = 0.0;
-    for k in 0..span.pow(D as u32) {
-        let offset: [f64; D] =
-            std::array::from_fn(|d| ((k / span.pow(d as u32)) % span - reach) as f64);
+    for_each_lattice_point([-reach; D], [reach + 1; D], |k| {
+        let offset = k.map(|o| o as f64);
         if offset.iter().all(|&o| o <= 1.0) {
             sum += kernel.w(norm(offset));
         }
-    }
+    });
     sum
 }
 

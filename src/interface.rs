@@ -16,6 +16,7 @@
 
 use crate::kernel::Quintic;
 use crate::lanes::F64s;
+use crate::lattice::for_each_lattice_point;
 use crate::neighbours::{Lanes, Neighbours};
 use crate::particles::{Kind, Particles};
 use crate::vector::norm;
@@ -44,15 +45,14 @@ impl Interfaces {
         let support = kernel.support();
         let step = support / TABLE_INTERVALS as f64;
         let reach = (support / spacing).ceil() as i64;
-        // Squared distances from the particle's foot of the lattice points of one layer.
-        let span = 2 * reach + 1;
-        let across: Vec<f64> = (0..span.pow(D as u32 - 1))
-            .map(|k| {
-                (0..D - 1)
-                    .map(|d| (((k / span.pow(d as u32)) % span - reach) as f64 * spacing).powi(2))
-                    .sum()
-            })
-            .collect();
+        // Squared distances from the particle's foot of the lattice points of one layer (the
+        // lattice points with no offset along the last axis).
+        let (mut lo, mut hi) = ([-reach; D], [reach + 1; D]);
+        (lo[D - 1], hi[D - 1]) = (0, 1);
+        let mut across = Vec::new();
+        for_each_lattice_point(lo, hi, |k| {
+            across.push(k.iter().map(|&o| (o as f64 * spacing).powi(2)).sum::<f64>());
+        });
         let volume = spacing.powi(D as i32);
         let beyond = (0..=TABLE_INTERVALS)
             .map(|k| {

@@ -164,7 +164,11 @@ fn near_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
 }
 
 /// Calls `f` for every integer point k with lo ≤ k < hi, x fastest.
-fn for_each_lattice_point<const D: usize>(lo: [i64; D], hi: [i64; D], mut f: impl FnMut([i64; D])) {
+pub fn for_each_lattice_point<const D: usize>(
+    lo: [i64; D],
+    hi: [i64; D],
+    mut f: impl FnMut([i64; D]),
+) {
     if (0..D).any(|d| hi[d] <= lo[d]) {
         return;
     }

@@ -101,7 +101,7 @@ fn describe(stage: Stage, scene: &Scene) -> String {
         Stage::CellList => {
             "counting sort by cell (x fastest), every particle array permuted together; the runs of cells around each fluid particle, which every pair loop of the step reads instead of searching the grid (about 20 runs of 6 B per fluid particle in 3D, not in the figure)".into()
         }
-        Stage::Density if scene.fluids.iter().any(|f| f.density != scene.fluids[0].density) => {
+        Stage::Density if scene.has_interfaces() => {
             "summation density ρ_i = ρ0_i Σ_j V_j W_ij (fluids of different density); each fluid particle's distance to the nearest interface and normal across it, from the other fluid's share of its kernel (the walls mirroring the fluid), for the pairs across it".into()
         }
         Stage::Density => "summation density ρ_i = Σ_j m_j W_ij; walls keep ρ0".into(),

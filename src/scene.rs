@@ -346,6 +346,14 @@ impl Scene {
         self.solver.h_over_dx * self.spacing
     }
 
+    /// Whether the fluids differ in rest density: the scene has interfaces whose pairs are
+    /// weighted (`interface`).
+    pub fn has_interfaces(&self) -> bool {
+        self.fluids
+            .iter()
+            .any(|f| f.density != self.fluids[0].density)
+    }
+
     /// A hash of everything in the validated scene that shapes the trajectory: xxh3-64 of its
     /// Debug rendering (which prints every f64 so that it reads back to the same bits), with the
     /// fields that cannot change a step blanked: the file's path, the run's name, `end_time`

@@ -145,9 +145,7 @@ impl<const D: usize> Simulation<D> {
             scratch: Vec::new(),
             work: Workspace::new(
                 scene
-                    .fluids
-                    .iter()
-                    .any(|f| f.density != scene.fluids[0].density)
+                    .has_interfaces()
                     .then(|| Interfaces::new(&Quintic::<D>::new(h), scene.spacing)),
             ),
             timings: Timings::default(),

@@ -3,6 +3,7 @@
 
 use crate::kernel::Quintic;
 use crate::lanes::{F64s, Sum};
+use crate::lattice::for_each_lattice_point;
 use crate::neighbours::Lanes;
 pub use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
@@ -169,21 +170,19 @@ pub fn min_correction_determinant<const D: usize>(h_over_dx: f64) -> f64 {
 fn wall_corner_determinant<const D: usize>(h_over_dx: f64) -> f64 {
     let kernel = Quintic::<D>::new(h_over_dx);
     let reach = kernel.support().ceil() as i64;
-    let span = 2 * reach + 1;
     let mut m = [[0.0; D]; D];
-    for k in 0..span.pow(D as u32) {
-        let offset: [f64; D] =
-            std::array::from_fn(|d| ((k / span.pow(d as u32)) % span - reach) as f64);
+    for_each_lattice_point([-reach; D], [reach + 1; D], |k| {
+        let offset = k.map(|o| o as f64);
         let r = offset.iter().map(|o| o * o).sum::<f64>().sqrt();
         if r == 0.0 || r >= kernel.support() {
-            continue;
+            return;
         }
         let behind: [bool; D] = std::array::from_fn(|d| d < D - 1 && offset[d] >= 1.0);
         let followed: [f64; D] = match (behind.iter().any(|&b| b), offset.iter().all(|&o| o <= 0.0))
         {
             (true, _) => std::array::from_fn(|d| if behind[d] { offset[d] } else { 0.0 }),
             (false, true) => offset,
-            (false, false) => continue,
+            (false, false) => return,
         };
         // ∇_i W_ij ⊗ r_ji with r_ij = −offset.
         let factor = kernel.grad_factor(r);
@@ -192,7 +191,7 @@ fn wall_corner_determinant<const D: usize>(h_over_dx: f64) -> f64 {
                 m[a][b] -= factor * offset[a] * followed[b];
             }
         }
-    }
+    });
     invert(m).map_or(0.0, |(_, det)| det)
 }
 
