@@ -4,17 +4,18 @@
 //! preconditioner of the step (fluid particles/s), and a full `Simulation` step (fluid
 //! particles/s).
 //!
-//! The PPE operator is rebuilt from the state through the public API (`isph::bench::PpeSetup`:
+//! The PPE operator is rebuilt from the state through the public API (`isph::tools::bench::PpeSetup`:
 //! the step's roles, row vectors zero, so each pair costs the step's arithmetic).
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
-use isph::bench::{dam_break_scene, PpeSetup};
-use isph::linsolve::{BiCgStab, LinearOperator, Preconditioner, SolverParams};
-use isph::multigrid::Multigrid;
+use isph::math::reduce::fill;
+use isph::neighbours::Neighbours;
 use isph::particles::Particles;
-use isph::reduce::fill;
 use isph::simulation::Simulation;
-use isph::sph::{self, Neighbours};
+use isph::solver::krylov::{BiCgStab, LinearOperator, Preconditioner, SolverParams};
+use isph::solver::multigrid::Multigrid;
+use isph::sph;
+use isph::tools::bench::{dam_break_scene, PpeSetup};
 use std::time::Duration;
 
 /// Steps taken before the state is benched: past the PPE's cold start from rest.

@@ -1,20 +1,20 @@
 //! The state of a run and its time stepping: the cell sort, the time-step limits, the
 //! projection step of `step`, and the diagnostics of each step.
 
-use crate::faces::{Contact, Faces};
-use crate::free_surface;
-use crate::grid::CellList;
-use crate::interface::Interfaces;
-use crate::kernel::{Quintic, SUPPORT_IN_H};
-use crate::lattice;
-use crate::linsolve::{SolverError, SolverParams};
-use crate::memory::ArraySize;
+use crate::boundary::faces::{Contact, Faces};
+use crate::fill;
+use crate::math::kernel::{Quintic, SUPPORT_IN_H};
+use crate::math::memory::ArraySize;
+use crate::math::reduce;
+use crate::neighbours::cell_list::CellList;
 use crate::particles::Particles;
-use crate::reduce;
 use crate::scene::{GhostPressure, Scene};
+use crate::solver::krylov::{SolverError, SolverParams};
 use crate::sph;
+use crate::sph::free_surface;
+use crate::sph::interface::Interfaces;
+use crate::step::timings::{Stage, Timings};
 use crate::step::{speed, StepLength, StepReport, StepSettings, Workspace};
-use crate::timings::{Stage, Timings};
 use std::time::Instant;
 
 /// Viscous time-step limit Δt ≤ C_ν h²/ν.
@@ -97,18 +97,18 @@ impl<const D: usize> Simulation<D> {
             scene.dimensions, D,
             "scene dimension and solver dimension differ"
         );
-        let particles = lattice::build::<D>(scene);
+        let particles = fill::build::<D>(scene);
         if particles.fluid_count() == 0 {
             return Err(NoFluid {
                 path: scene.path.clone(),
             });
         }
-        let confined = lattice::fills_container(scene, &particles);
+        let confined = fill::fills_container(scene, &particles);
         let h = scene.smoothing_length();
         // Bounded axes: room for the wall layers and a spacing more; a periodic axis is one
         // period, the container's extent.
         let periodic: [bool; D] = std::array::from_fn(|d| scene.periodic[d]);
-        let walls = (lattice::wall_layers(scene) as f64 + 1.0) * scene.spacing;
+        let walls = (scene.wall_layers() as f64 + 1.0) * scene.spacing;
         let margin = |d: usize| if periodic[d] { 0.0 } else { walls };
         let lo = std::array::from_fn(|d| scene.container.min[d] - margin(d));
         let hi = std::array::from_fn(|d| scene.container.max[d] + margin(d));

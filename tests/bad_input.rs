@@ -249,6 +249,6 @@ fn a_block_one_spacing_wide_is_accepted() {
         )
         .replace("spacing = 0.02", "spacing = 0.02\nname = \"one\"");
     let scene = crate::common::scene_from_text(&text);
-    let plan = isph::plan::Plan::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let plan = isph::tools::plan::Plan::new(&scene).unwrap_or_else(|e| panic!("{e}"));
     assert!(plan.to_string().contains("particles: 1 fluid"), "{plan}");
 }

@@ -6,7 +6,7 @@ use crate::common::{isph_command, TempDir};
 use isph::io::checkpoint::Checkpoint;
 use isph::io::checkpoint_folder;
 use isph::particles::{ArrayMut, Kind, Particles};
-use isph::resume::{self, ResumeOptions};
+use isph::run::resume::{self, ResumeOptions};
 use isph::run::{self, RunError, RunOptions, StopSignal};
 use isph::scene::Scene;
 use std::collections::BTreeMap;

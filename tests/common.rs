@@ -1,7 +1,7 @@
 //! Shared helpers: lattices of particles sorted into a cell list, scenes, and runs.
 
-use isph::grid::CellList;
-use isph::kernel::{Quintic, SUPPORT_IN_H};
+use isph::math::kernel::{Quintic, SUPPORT_IN_H};
+use isph::neighbours::cell_list::CellList;
 use isph::particles::{Kind, NewParticle, Particles};
 use isph::run::{run, RunOptions, RunSummary};
 use isph::scene::Scene;

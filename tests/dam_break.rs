@@ -1,8 +1,8 @@
 //! Dam breaks: the 2D surge front against Martin & Moyce (1952) and a 3D run.
 
 use crate::common::{run_scene, shipped_scene, stats_column, TempDir};
-use isph::validation::dam_break::Column;
-use isph::validation::{measure, Case};
+use isph::tools::validation::dam_break::Column;
+use isph::tools::validation::{measure, Case};
 
 /// Martin & Moyce's 2:1 column at a/30 in a tank long enough for all fifteen of their fronts
 /// (`scenes/dam_break_mm_2d.toml`). Measured: 7.6% mean relative error (7.2% before the

@@ -3,11 +3,11 @@
 //! refused, and a scene without `[effects]` runs as before.
 
 use crate::common::{run_scene, water_block_scene, TempDir};
-use isph::memory::Holds;
-use isph::plan::Plan;
+use isph::math::memory::Holds;
 use isph::scene::Scene;
 use isph::simulation::Simulation;
-use isph::timings::Stage;
+use isph::step::timings::Stage;
+use isph::tools::plan::Plan;
 use std::path::Path;
 
 /// A 10 × 10 block of water in a 20 × 15 box (`water_block_scene`), then `effects` appended.

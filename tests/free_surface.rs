@@ -2,9 +2,10 @@
 //! in 2D and 3D: exactly the particles on the outside of the fluid take P = 0.
 
 use crate::common::Lattice;
-use isph::free_surface::{spray_density, Support};
+use isph::neighbours::Neighbours;
 use isph::particles::Kind;
-use isph::sph::{density, support_moments, Neighbours};
+use isph::sph::free_surface::{spray_density, Support};
+use isph::sph::{density, support_moments};
 
 const DX: f64 = 0.01;
 const H_OVER_DX: f64 = 1.2;

@@ -1,7 +1,7 @@
 //! Hydrostatic tank (2D): the pressure against ρ g (H − y) after 1 s, and water that stays still.
 
 use crate::common::{read_frame, run_scene, scene_from_text, shipped_scene, stats_column, TempDir};
-use isph::validation::{measure, Case};
+use isph::tools::validation::{measure, Case};
 use std::path::Path;
 
 #[test]
@@ -300,7 +300,7 @@ fn blocks_stacked_on_a_lattice_plane_leave_no_empty_layer() {
             "[[fluid]]\nname = \"oil\"\ndensity = 800.0\nviscosity = 1.0e-4\n\n\
              [[fluid_block]]\nfluid = \"oil\"\nmin = [0.0, 0.11]\nmax = [0.2, 0.2]\n\n[container]",
         );
-    let p = isph::lattice::build::<2>(&scene_from_text(&stacked));
+    let p = isph::fill::build::<2>(&scene_from_text(&stacked));
     let rows = |fluid: u16| -> Vec<i64> {
         let mut rows: Vec<i64> = (0..p.len())
             .filter(|&i| p.is_fluid(i) && p.fluid[i] == fluid)
@@ -316,7 +316,7 @@ fn blocks_stacked_on_a_lattice_plane_leave_no_empty_layer() {
     let lone =
         crate::common::water_block_scene(0.1).replace("max = [0.2, 0.2]", "max = [0.2, 0.11]");
     assert_eq!(
-        isph::lattice::build::<2>(&scene_from_text(&lone)).fluid_count(),
+        isph::fill::build::<2>(&scene_from_text(&lone)).fluid_count(),
         50
     );
 }

@@ -2,13 +2,13 @@
 //! particle reads off the other fluid's share of its kernel, and the pair density between two.
 
 use crate::common::Lattice;
-use isph::faces::Faces;
-use isph::interface::{other_fluid_share, pair_weight, Interfaces};
-use isph::lanes::F64s;
+use isph::boundary::faces::Faces;
+use isph::math::lanes::F64s;
+use isph::math::vector::unit;
+use isph::neighbours::Neighbours;
 use isph::particles::Kind;
 use isph::scene::Aabb;
-use isph::sph::Neighbours;
-use isph::vector::unit;
+use isph::sph::interface::{other_fluid_share, pair_weight, Interfaces};
 
 const DX: f64 = 0.01;
 
@@ -144,7 +144,7 @@ fn the_distance_to_a_flat_interface_is_read_off_the_kernel() {
 
 #[test]
 fn far_from_any_other_fluid_the_distance_is_the_support_and_inside_it_zero() {
-    let table = Interfaces::new(&isph::kernel::Quintic::<3>::new(0.012), 0.01);
+    let table = Interfaces::new(&isph::math::kernel::Quintic::<3>::new(0.012), 0.01);
     assert!((table.distance(0.0) - 0.036).abs() < 1e-15);
     assert!(table.distance(0.5) < 1e-4 * 0.012);
     assert_eq!(table.distance(0.8), 0.0);

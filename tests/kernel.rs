@@ -1,8 +1,8 @@
 //! The quintic kernel of Eq. (19): normalisation and the gradient of a linear field.
 
 use crate::common::Lattice;
-use isph::kernel::Quintic;
-use isph::sph::Neighbours;
+use isph::math::kernel::Quintic;
+use isph::neighbours::Neighbours;
 
 /// ∫W dV by the midpoint rule on a lattice of `n` points per h.
 fn integral<const D: usize>(n: i64) -> f64 {

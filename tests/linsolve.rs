@@ -1,8 +1,8 @@
 //! BiCGSTAB against a dense direct solve on a non-symmetric sparse system, and with the
 //! multigrid preconditioner on rows that couple to nothing.
 
-use isph::linsolve::{BiCgStab, Jacobi, LinearOperator, Preconditioner, SolverParams};
-use isph::multigrid::{stencil_slot, Aggregated, Multigrid};
+use isph::solver::krylov::{BiCgStab, Jacobi, LinearOperator, Preconditioner, SolverParams};
+use isph::solver::multigrid::{stencil_slot, Aggregated, Multigrid};
 
 /// 1D convection–diffusion: −x_{i−1}(1 + c) + 2 x_i (1 + s_i) − x_{i+1}(1 − c), non-symmetric.
 struct ConvectionDiffusion {

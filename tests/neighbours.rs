@@ -1,9 +1,9 @@
 //! The cell-list pair loop against a brute-force O(N²) search (its slow, obvious twin).
 
-use isph::grid::{CellList, KINDS};
-use isph::kernel::{Quintic, SUPPORT_IN_H};
+use isph::math::kernel::{Quintic, SUPPORT_IN_H};
+use isph::neighbours::cell_list::{CellList, KINDS};
+use isph::neighbours::Neighbours;
 use isph::particles::{Kind, NewParticle, Particles};
-use isph::sph::Neighbours;
 
 /// A small deterministic pseudo-random sequence in [0, 1).
 fn lcg(state: &mut u64) -> f64 {

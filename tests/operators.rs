@@ -2,8 +2,9 @@
 //! pressure gradient takes its reference from near a free surface.
 
 use crate::common::Lattice;
+use isph::neighbours::Neighbours;
 use isph::particles::Kind;
-use isph::sph::{fitted_value, laplacian_coefficient, Neighbours};
+use isph::sph::{fitted_value, laplacian_coefficient};
 
 /// −Σ_j a_ij (φ_i − φ_j) at the lattice centre for φ = |x|², whose Laplacian is 2D.
 fn laplacian_of_quadratic<const D: usize>(n: i64, h_over_dx: f64) -> f64 {
@@ -104,7 +105,7 @@ fn fitted_value_is_none_where_the_neighbours_fix_no_plane() {
 /// A NaN among the values is the maximum: a NaN speed stops the run as non-finite.
 #[test]
 fn the_maximum_keeps_a_nan() {
-    use isph::reduce::max;
+    use isph::math::reduce::max;
     let values = [0.5, 2.0, 1.0, 0.25];
     assert_eq!(max(values.len(), |i| values[i]), 2.0);
     assert_eq!(max(0, |_| 1.0), 0.0);

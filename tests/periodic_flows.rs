@@ -1,9 +1,9 @@
 //! The two analytic flows of periodic boxes, each at two spacings: the Taylor–Green vortex's
-//! decay and the start-up Poiseuille flow, measured by `isph::validation` (the measures of
+//! decay and the start-up Poiseuille flow, measured by `isph::tools::validation` (the measures of
 //! `isph study`), with the order of convergence fitted from the two spacings.
 
 use crate::common::{run_scene, shipped_scene, TempDir};
-use isph::validation::{measure, Case, Measured};
+use isph::tools::validation::{measure, Case, Measured};
 
 /// Runs the shipped scene `name` at `spacing` to `until` and measures it against `case`.
 fn measured(name: &str, case: Case, spacing: f64, until: f64) -> Measured {

@@ -2,13 +2,14 @@
 //! twins: scalar sums over every pair of particles (O(N²)) with the scalar kernel, on a
 //! disordered block of fluid over a floor of wall particles, in 2D and 3D.
 
-use isph::grid::CellList;
-use isph::kernel::{Quintic, SUPPORT_IN_H};
-use isph::linsolve::LinearOperator;
-use isph::multigrid::Aggregated;
+use isph::math::kernel::{Quintic, SUPPORT_IN_H};
+use isph::neighbours::cell_list::CellList;
+use isph::neighbours::Neighbours;
 use isph::particles::{Kind, NewParticle, Particles};
-use isph::ppe::{self, PressureOperator, Role};
-use isph::sph::{self, Corrections, Neighbours};
+use isph::solver::krylov::LinearOperator;
+use isph::solver::multigrid::Aggregated;
+use isph::solver::ppe::{self, PressureOperator, Role};
+use isph::sph::{self, Corrections};
 
 const DX: f64 = 0.01;
 const H_OVER_DX: f64 = 1.2;
@@ -147,8 +148,8 @@ fn check<const D: usize>(n: i64) {
         let fast = sph::gradient(&nb, &p, &None, i, |l| {
             let x0 = l.load(&p.pos[0]);
             let x1 = l.load(&p.pos[1]);
-            x0 * isph::lanes::F64s::splat(3.0) - x1 * isph::lanes::F64s::splat(2.0)
-                + isph::lanes::F64s::splat(1.0 - phi_i)
+            x0 * isph::math::lanes::F64s::splat(3.0) - x1 * isph::math::lanes::F64s::splat(2.0)
+                + isph::math::lanes::F64s::splat(1.0 - phi_i)
         });
         for d in 0..D {
             assert!(
@@ -182,7 +183,7 @@ fn simd_operators_match_their_scalar_twins() {
 /// sums written out, over chunks of pseudo-random terms).
 #[test]
 fn lane_sums_have_the_bits_of_four_lanes() {
-    use isph::lanes::{F64s, Sum, LANES};
+    use isph::math::lanes::{F64s, Sum, LANES};
     let mut seed = 7;
     let terms: Vec<(f64, f64)> = (0..64 * LANES)
         .map(|_| (lcg(&mut seed) - 0.5, 1e3 * lcg(&mut seed)))

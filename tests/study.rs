@@ -2,8 +2,8 @@
 //! by another process), and bad study files refused with the file and key named.
 
 use crate::common::{isph_command, TempDir};
-use isph::study::claim;
-use isph::study::file::point_id;
+use isph::tools::study::claim;
+use isph::tools::study::file::point_id;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::time::SystemTime;

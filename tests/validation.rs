@@ -1,10 +1,12 @@
-//! The pure parts of the error measures (`isph::validation`): synthetic fronts, frames and
+//! The pure parts of the error measures (`isph::tools::validation`): synthetic fronts, frames and
 //! columns with known answers.
 
 use isph::io::frames::Frame;
-use isph::validation::dam_break::{pick_frames, relative_errors, Column, MARTIN_MOYCE_FRONT};
-use isph::validation::hydrostatic::WaterColumn;
-use isph::validation::Case;
+use isph::tools::validation::dam_break::{
+    pick_frames, relative_errors, Column, MARTIN_MOYCE_FRONT,
+};
+use isph::tools::validation::hydrostatic::WaterColumn;
+use isph::tools::validation::Case;
 
 /// A frame of fluid particles (kind 0) at `points` (x, y), plus one wall particle far away.
 fn frame(points: &[(f64, f64)]) -> Frame {
@@ -145,9 +147,9 @@ fn a_run_is_measured_only_against_its_own_scene() {
     crate::common::run_scene(&scene, dir.path(), 0.02);
     let mut longer = scene.clone();
     longer.end_time *= 2.0;
-    assert!(isph::validation::measure(Case::Hydrostatic, &longer, dir.path()).is_ok());
+    assert!(isph::tools::validation::measure(Case::Hydrostatic, &longer, dir.path()).is_ok());
     let mut other = scene.clone();
     other.solver.alpha = 0.2;
-    let e = isph::validation::measure(Case::Hydrostatic, &other, dir.path()).unwrap_err();
+    let e = isph::tools::validation::measure(Case::Hydrostatic, &other, dir.path()).unwrap_err();
     assert!(e.to_string().contains("another scene"), "{e}");
 }

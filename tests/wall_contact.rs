@@ -3,7 +3,7 @@
 //! face; one that did not is left alone; only the crossings count as penetrations), the
 //! kinematic condition of the particles touching a face, and the wall particles' normals.
 
-use isph::faces::{Contact, Faces};
+use isph::boundary::faces::{Contact, Faces};
 use isph::scene::Aabb;
 
 fn aabb(min: [f64; 2], max: [f64; 2]) -> Aabb {

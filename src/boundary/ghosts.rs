@@ -1,0 +1,156 @@
+//! Walls: layers of fixed dummy particles that fill the kernel support beyond the boundary.
+//!
+//! A wall particle carries no unknown of the pressure solve. Every fluid particle i sees each
+//! wall neighbour b as the continuation of its own pressure field under the Neumann condition
+//! of the projection, ∂P/∂n = ρ0 g·n on a wall at rest:
+//!
+//!   P_b = P_i + ρ0 g·N_b (r_b − r_i),                                               (ghost)
+//!
+//! N_b the projector on the normals of the walls b lies behind: n nᵀ behind a plane wall, the
+//! identity in a corner of the container (behind two walls in 2D, three in 3D; behind two
+//! walls of a 3D box, the projector on their plane). The walls are axis-aligned (container and
+//! box obstacles), so N_b keeps the axes along which b's normal has a component. Only the
+//! normal part of the hydrostatic gradient is carried into the wall: along the wall the fluid
+//! may be accelerating (a column falling beside a wall, a surge running along the floor), and a
+//! hydrostatic gradient along the wall there would suck fluid into dry wall above it. Because the ghost difference P_b − P_i does
+//! not depend on the unknowns, the wall pairs of a PPE row are known numbers: the Neumann condition
+//! becomes a source term and the matrix couples fluid particles only.
+//!
+//! The kinematic condition u·n = 0 enters the PPE source through the velocity divergence, where
+//! the wall particles take the wall velocity (zero) plus the fluid particle's own predictor
+//! increment (see `ppe::source`).
+
+use crate::math::lanes::{F64s, Sum};
+use crate::math::vector::dot;
+use crate::neighbours::Lanes;
+use crate::neighbours::Neighbours;
+use crate::particles::{Kind, Particles};
+
+/// P_b − P_i = −ρ0_i g·N_b r_ib of the ghost pressures of the wall particles b in lanes `l`
+/// seen from fluid particle i (r_ib = r_i − r_b, the lanes' r_ij).
+#[inline(always)]
+pub fn ghost_pressure_difference<const D: usize>(
+    p: &Particles<D>,
+    gravity: [f64; D],
+    i: usize,
+    l: &Lanes<D>,
+) -> F64s {
+    let across = behind_walls(p, l, l.rij);
+    let g_r = (0..D).fold(F64s::ZERO, |s, d| {
+        F64s::splat(gravity[d]).mul_add(across[d], s)
+    });
+    F64s::splat(-p.rest_density[i]) * g_r
+}
+
+/// N_b r: the part of r across the walls the wall particles b in lanes `l` lie behind (see
+/// the module doc).
+#[inline(always)]
+pub fn behind_walls<const D: usize>(p: &Particles<D>, l: &Lanes<D>, r: [F64s; D]) -> [F64s; D] {
+    std::array::from_fn(|d| r[d] & l.load(&p.normal[d]).simd_ne(F64s::ZERO))
+}
+
+/// The velocities the wall particles b in lanes `l` take in the velocity gradients of fluid
+/// particle i (the
+/// divergence of the PPE source, the strain rate of the eddy viscosity, the Taylor correction
+/// of shifting): the fluid's own velocity `u_i` with its normal part `u_n` (relative to the wall,
+/// at rest) removed, N_b here as for the pressure ghosts. The wall is then felt only through
+/// the normal velocity, the kinematic condition; along the wall it continues the fluid, a
+/// free-slip ghost. At rest in these gradients (no-slip), the wall shows a shear of order
+/// U/dx, which the kernel correction mixes into the divergence where the support is truncated
+/// (a surge front) and which a shift across it turns into a spurious change of velocity.
+#[inline(always)]
+pub fn ghost_velocity<const D: usize>(
+    p: &Particles<D>,
+    l: &Lanes<D>,
+    u_i: [f64; D],
+    u_n: [f64; D],
+) -> [F64s; D] {
+    let across = behind_walls(p, l, u_n.map(F64s::splat));
+    std::array::from_fn(|d| F64s::splat(u_i[d]) - across[d])
+}
+
+/// What the ghost pressures of the walls are made of, borrowed apart from the pressures
+/// themselves (the wall pressure is written beside the fluid's it is computed from).
+pub struct Ghosts<'a, const D: usize> {
+    pub rest_density: &'a [f64],
+    pub normal: &'a [Vec<f64>; D],
+    pub gravity: [f64; D],
+}
+
+impl<const D: usize> Ghosts<'_, D> {
+    /// Pressure of wall particle b for the frames: the kernel-weighted mean of the
+    /// ghost pressures its fluid neighbours give it (zero where no fluid is in reach), with
+    /// `fluid_pressure` the pressures of the fluid particles.
+    pub fn wall_pressure(&self, nb: &Neighbours<D>, fluid_pressure: &[f64], b: usize) -> f64 {
+        // P_b − P_f = −ρ0_f g·N_b r_fb (see the module doc), r_fb = −r_bf; N_b is b's own.
+        let g_across: [F64s; D] = std::array::from_fn(|d| {
+            F64s::splat(if self.normal[d][b] != 0.0 {
+                self.gravity[d]
+            } else {
+                0.0
+            })
+        });
+        let (mut sum, mut weights) = (Sum::ZERO, Sum::ZERO);
+        nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
+            let w = nb.kernel.w_lanes(l.r) & l.mask;
+            let g_r = (0..D).fold(F64s::ZERO, |s, d| g_across[d].mul_add(l.rij[d], s));
+            let ghost = l
+                .load(self.rest_density)
+                .mul_add(g_r, l.load(fluid_pressure));
+            sum = sum.mul_add(w, ghost);
+            weights += w;
+        });
+        let (sum, weights) = (sum.total(), weights.total());
+        if weights > 0.0 {
+            sum / weights
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The wall particle b nearest to particle i closer than `within`, with r_ib and |r_ib|, if any.
+pub fn nearest_wall<const D: usize>(
+    nb: &Neighbours<D>,
+    within: f64,
+    i: usize,
+) -> Option<(usize, [f64; D], f64)> {
+    let mut nearest = (within, None);
+    nb.for_each_of(i, &[Kind::Wall], |j, rij, r| {
+        if r < nearest.0 {
+            nearest = (r, Some((j, rij)));
+        }
+    });
+    nearest.1.map(|(j, rij)| (j, rij, nearest.0))
+}
+
+/// The face of the wall nearest to a fluid particle.
+#[derive(Clone, Copy, Debug)]
+pub struct Face<const D: usize> {
+    /// Distance from the particle to the face: the nearest wall particle's separation along
+    /// its normal less the half spacing from a wall particle's centre to the face, and at
+    /// least a quarter spacing (a particle pressed against the face).
+    pub distance: f64,
+    /// The wall's normal, into the fluid.
+    pub normal: [f64; D],
+    /// Distance from the particle to the nearest wall particle.
+    pub reach: f64,
+}
+
+/// The face of the nearest wall whose particles come closer to fluid particle i than
+/// `within`, if any.
+pub fn nearest_face<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    spacing: f64,
+    within: f64,
+    i: usize,
+) -> Option<Face<D>> {
+    let (b, r_ib, reach) = nearest_wall(nb, within, i)?;
+    let normal = p.wall_normal(b);
+    Some(Face {
+        distance: (dot(r_ib, normal) - 0.5 * spacing).max(0.25 * spacing),
+        normal,
+        reach,
+    })
+}

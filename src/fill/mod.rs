@@ -1,0 +1,139 @@
+//! Initial particles on a lattice of spacing dx anchored at the container's lower corner:
+//! fluid blocks, the container's dummy wall layers and solid obstacles.
+
+use crate::boundary::faces::Faces;
+use crate::math::lattice::for_each_lattice_point;
+use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
+use crate::scene::{Block, Scene};
+
+/// Particles of the scene at t = 0: fluid first (in block order), then walls.
+pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
+    let dx = scene.spacing;
+    let volume = dx.powi(D as i32);
+    let layers = scene.wall_layers() as i64;
+    let cells = container_cells::<D>(scene);
+    let point = |k: [i64; D]| lattice_point(scene, k);
+    let in_obstacle = |x: &[f64; D]| in_obstacle(scene, x);
+    let near_obstacle = |x: &[f64; D]| near_obstacle(scene, x);
+
+    let mut particles = Particles::<D>::default();
+    for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
+        let x = point(k);
+        if let (Some(b), false) = (block_of(scene, &x), near_obstacle(&x)) {
+            let fluid = &scene.fluids[b.fluid];
+            particles.push(NewParticle {
+                pos: x,
+                kind: Kind::Fluid,
+                normal: [0.0; D],
+                fluid: b.fluid as u16,
+                mass: fluid.density * volume,
+                rest_density: fluid.density,
+                viscosity: fluid.viscosity,
+            });
+        }
+    });
+    let faces = Faces::new(scene);
+    let wall_density = scene.fluids[0].density;
+    let wall = |x: [f64; D]| NewParticle {
+        pos: x,
+        kind: Kind::Wall,
+        normal: faces.wall_normal(x),
+        fluid: NO_FLUID,
+        mass: wall_density * volume,
+        rest_density: wall_density,
+        viscosity: 0.0,
+    };
+    if let Some(field) = &scene.initial_velocity {
+        for i in 0..particles.len() {
+            let u = field.at(&scene.container, particles.position(i));
+            for (axis, u) in particles.vel.iter_mut().zip(u) {
+                axis[i] = u;
+            }
+        }
+    }
+    // Container walls: every lattice point within `layers` of the box, outside it; none across
+    // a periodic axis.
+    let margin = |d: usize| if scene.periodic[d] { 0 } else { layers };
+    let outer_lo = std::array::from_fn(|d| -margin(d));
+    let outer_hi = std::array::from_fn(|d| cells[d] + margin(d));
+    for_each_lattice_point(outer_lo, outer_hi, |k| {
+        if (0..D).any(|d| k[d] < 0 || k[d] >= cells[d]) {
+            particles.push(wall(point(k)));
+        }
+    });
+    // Obstacles: solid boxes of wall particles.
+    for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
+        let x = point(k);
+        if in_obstacle(&x) {
+            particles.push(wall(x));
+        }
+    });
+    particles
+}
+
+/// The block lattice point x belongs to: the first that holds it strictly inside. A point on
+/// a block's face (within 1e-9 dx) belongs to the first block whose face it lies on when the
+/// blocks cover more than half of its cell (counted at the centres of its 2^D sub-cells): two
+/// blocks stacked on a face through a lattice plane leave no empty layer between them (which
+/// fell in, or took a whole plane of fluid for free surface), while the face of a lone block
+/// keeps its points out, as half their cell lies outside.
+fn block_of<'a, const D: usize>(scene: &'a Scene, x: &[f64; D]) -> Option<&'a Block> {
+    let blocks = &scene.blocks;
+    if let Some(b) = blocks.iter().find(|b| b.region.contains(x)) {
+        return Some(b);
+    }
+    let on_face = blocks
+        .iter()
+        .find(|b| b.region.contains_within(x, 1e-9 * scene.spacing))?;
+    let quarter = 0.25 * scene.spacing;
+    let covered = (0..1usize << D)
+        .filter(|corner| {
+            let probe: [f64; D] = std::array::from_fn(|d| {
+                x[d] + if corner >> d & 1 == 1 {
+                    quarter
+                } else {
+                    -quarter
+                }
+            });
+            blocks.iter().any(|b| b.region.contains(&probe))
+        })
+        .count();
+    (2 * covered > 1 << D).then_some(on_face)
+}
+
+/// Whether the fluid fills the container: every lattice point inside it and outside the
+/// obstacles holds a fluid particle. Incompressible fluid that fills a closed or periodic box
+/// has no free surface, and can never make one.
+pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) -> bool {
+    let mut room = 0;
+    for_each_lattice_point([0; D], container_cells::<D>(scene), |k| {
+        room += !near_obstacle(scene, &lattice_point(scene, k)) as usize;
+    });
+    particles.fluid_count() == room
+}
+
+/// Lattice points per axis inside the container.
+fn container_cells<const D: usize>(scene: &Scene) -> [i64; D] {
+    let (lo, hi) = (&scene.container.min, &scene.container.max);
+    std::array::from_fn(|d| ((hi[d] - lo[d]) / scene.spacing).round() as i64)
+}
+
+/// Lattice point k (per axis): container.min + (k + ½) dx.
+fn lattice_point<const D: usize>(scene: &Scene, k: [i64; D]) -> [f64; D] {
+    let lo = &scene.container.min;
+    std::array::from_fn(|d| lo[d] + (k[d] as f64 + 0.5) * scene.spacing)
+}
+
+fn in_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
+    scene.obstacles.iter().any(|o| o.contains(x))
+}
+
+/// Whether x lies inside an obstacle or less than half a spacing outside it: no fluid particle
+/// starts there. With the obstacle's faces between lattice points (container.min + k dx) the
+/// nearest fluid is half a spacing off, as at the container's walls; a face through lattice
+/// points would otherwise put fluid on the face itself, pushed back and counted as crossing it
+/// in the first step.
+fn near_obstacle<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
+    let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
+    scene.obstacles.iter().any(|o| o.contains_within(x, margin))
+}

@@ -1,0 +1,10 @@
+//! The mathematics every layer shares, which knows nothing of particles or scenes: small
+//! vectors, SIMD lanes, thread-count-independent parallel loops and sums, the kernel of Eq. (19),
+//! the walk over lattice points, and the sizes of arrays.
+
+pub mod kernel;
+pub mod lanes;
+pub mod lattice;
+pub mod memory;
+pub mod reduce;
+pub mod vector;

@@ -1,0 +1,548 @@
+//! The pressure Poisson equation of Eq. (6), assembled matrix-free. The unknowns are the fluid
+//! pressures; wall particles are ghosts of them (see `wall`) and hold no unknown.
+//!
+//! * interior rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt², with the Laplacian of
+//!   Eq. (27) made first-order consistent where the free surface truncates the kernel. The wall
+//!   pairs of the Laplacian are known ghost differences and move to the right-hand side.
+//! * free-surface rows: P_i = ρ0 |g| dx/2 (`surface_pressure`): P = 0 holds on the surface
+//!   itself, half a spacing beyond the centre of the outermost particle, where the volume that
+//!   particle stands for ends. (P_i = 0 at the particle would put the surface half a spacing
+//!   too low and the hydrostatic pressure ρ g dx/2 short everywhere below.)
+//! * splash rows (particles too isolated for a gradient): P_i = 0.
+//!
+//! The walls have no row: their pressures for output are computed after the solve from their
+//! fluid neighbours (`wall::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
+//! first in the sorted order).
+
+use crate::boundary::ghosts::{behind_walls, ghost_pressure_difference, ghost_velocity};
+use crate::math::lanes::{F64s, Sum, LANES};
+use crate::math::reduce::{fill, fill_vector};
+use crate::neighbours::Lanes;
+use crate::neighbours::Neighbours;
+use crate::particles::{Kind, Particles};
+use crate::solver::krylov::LinearOperator;
+use crate::solver::multigrid::{stencil_slot, Aggregated};
+use crate::sph::free_surface::Support;
+use crate::sph::interface::{Field, Side};
+use crate::sph::{mass_at_density, velocity_gradient, Correction, Corrections};
+use rayon::prelude::*;
+
+/// The role of a particle in the pressure solve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// Fluid with a full neighbourhood: the Laplacian row.
+    Interior,
+    /// Fluid on the free surface: P = ρ0 |g| dx/2, the water above its centre (`surface_pressure`).
+    Surface,
+    /// Fluid too isolated to have a pressure gradient (spray, drops): P = 0.
+    Splash,
+    /// The one fluid particle pinned to P = 0 where the fluid has no free surface at all (a
+    /// closed or periodic box), whose PPE fixes the pressure only up to a constant.
+    Reference,
+}
+
+impl Role {
+    /// Whether the particle bounds the fluid at a free surface.
+    pub fn is_free(self) -> bool {
+        matches!(self, Role::Surface | Role::Splash)
+    }
+
+    /// The role's code in the frames' `free_surface` dataset (`Particles::free_surface`):
+    /// 1 free surface, 2 splash, 0 interior (walls have 0 too).
+    pub fn code(self) -> u8 {
+        match self {
+            Role::Surface => 1,
+            Role::Splash => 2,
+            Role::Interior | Role::Reference => 0,
+        }
+    }
+
+    /// The role of a fluid particle whose `free_surface` code is `code` (see `code`).
+    pub fn from_code(code: u8) -> Role {
+        match code {
+            1 => Role::Surface,
+            2 => Role::Splash,
+            _ => Role::Interior,
+        }
+    }
+}
+
+/// V_i = m_i/ρ0_i of the `nf` fluid particles: the volumes the PPE rows couple.
+pub fn fluid_volumes<const D: usize>(p: &Particles<D>, nf: usize, out: &mut Vec<f64>) {
+    out.resize(nf, 0.0);
+    fill(out, |i| p.mass[i] / p.rest_density[i]);
+}
+
+/// The role of particle i: fluid on the free surface (see `free_surface`) takes the surface
+/// row, or P = 0 where it has no consistent gradient (`gradient_defined` false: the moment
+/// matrix of its pressure gradient is near-singular, whether or not the scene applies the
+/// kernel correction). `fluid_neighbours` counts the fluid particles in its kernel support;
+/// `spray_density` is the kernel's `free_surface::spray_density`.
+pub fn role<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    support: &Support<D>,
+    fluid_neighbours: usize,
+    gradient_defined: bool,
+    spray_density: f64,
+    i: usize,
+) -> Role {
+    if fluid_neighbours == 0 || !gradient_defined {
+        Role::Splash
+    } else if support.is_free_surface(nb, i, p.density[i] / p.rest_density[i], spray_density) {
+        Role::Surface
+    } else {
+        Role::Interior
+    }
+}
+
+/// If the fluid has no free surface at all (a full closed or periodic box) the PPE is singular;
+/// the highest fluid particle (the first in index order among equals) is then the reference,
+/// pinned to P = 0. Returns it (None: the fluid has a free surface, and no reference).
+pub fn pin_reference<const D: usize>(
+    p: &Particles<D>,
+    gravity: [f64; D],
+    roles: &mut [Role],
+) -> Option<usize> {
+    if roles.iter().any(|r| r.is_free()) {
+        return None;
+    }
+    let top = highest(
+        p,
+        gravity,
+        (0..roles.len()).filter(|&i| roles[i] == Role::Interior),
+    )?;
+    roles[top] = Role::Reference;
+    Some(top)
+}
+
+/// The highest of the particles `among` against gravity, the first in index order among equals.
+pub fn highest<const D: usize>(
+    p: &Particles<D>,
+    gravity: [f64; D],
+    among: impl Iterator<Item = usize>,
+) -> Option<usize> {
+    let height = |i: usize| -(0..D).map(|d| gravity[d] * p.pos[d][i]).sum::<f64>();
+    among.max_by(|&a, &b| height(a).total_cmp(&height(b)).then(b.cmp(&a)))
+}
+
+/// Marks fluid particles whose kernel support holds no free-surface particle: there the
+/// summation density measures compression, not the truncation of the kernel at the surface.
+pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &mut Vec<bool>) {
+    full.resize(roles.len(), false);
+    fill(full, |i| {
+        if roles[i] != Role::Interior {
+            return false;
+        }
+        let mut any_free = false;
+        nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+            for k in 0..LANES {
+                any_free |= l.active(k) & roles.get(l.j0 + k).is_some_and(|r| r.is_free());
+            }
+        });
+        !any_free
+    });
+}
+
+/// The per-row vector of the operator, with L'_i the correction of the pressure gradient
+/// (`sph::Moments::m_neumann`): ĉ_i = L'_iᵀ c_i of the consistent Laplacian for interior rows
+/// (see `laplacian_correction`), zero otherwise. Deep inside the fluid c_i measures the
+/// disorder of the particles, and the row is corrected all the same: leaving those rows
+/// uncorrected let still water go unstable after about a second (max speed growing threefold
+/// every 0.17 s in `hydrostatic_2d`), with it the tank stays at rest.
+pub fn row_vectors<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    interfaces: Option<Field<D>>,
+    roles: &[Role],
+    pressure_corrections: Corrections<D>,
+    out: &mut [Vec<f64>; D],
+) {
+    fill_vector(out, |i| match roles[i] {
+        Role::Interior => laplacian_correction(nb, p, interfaces, pressure_corrections.of(i), i),
+        Role::Surface | Role::Splash | Role::Reference => [0.0; D],
+    });
+}
+
+/// Pressure of a free-surface particle: the surface itself lies about δ = dx/2 beyond the
+/// particle's centre, so P = 0 there puts P_i = ρ0 |g| δ, the weight of the water above the
+/// centre (exact in still water; where the true P_i is 0, as in a free-falling jet, it errs by
+/// ρ0 |g| dx/2 at most). Two ways of following the surface's orientation were measured and
+/// dropped on `hydrostatic_2d` run for 20 s: ρ0 δ (−g·n)⁺ with n the surface normal, and the
+/// Robin row P_i + δ n·∇P_i = 0; both let the surface layer oscillate with a slowly growing
+/// amplitude (max speed 0.01 and 0.5 m/s after 20 s), this constant keeps the tank at rest
+/// (below 1e-4 m/s).
+fn surface_pressure(rest_density: f64, gravity: f64, spacing: f64) -> f64 {
+    rest_density * gravity * 0.5 * spacing
+}
+
+/// Right-hand side b of the PPE rows (same sign convention as `PressureOperator`); `closed`:
+/// the fluid has no free surface (a particle is pinned as the reference); `sealed`: the
+/// unknowns of each region sealed off from the free surface where the rest has one (its
+/// highest particle pinned), whose compression is balanced like a closed box's;
+/// `density_rate`: α/Δt_max, the rate at which the density-invariance term relaxes the
+/// density error (`divergence_source`).
+#[allow(clippy::too_many_arguments)]
+pub fn source<const D: usize>(
+    op: &PressureOperator<D>,
+    closed: bool,
+    sealed: &[Vec<usize>],
+    full: &[bool],
+    spacing: f64,
+    corrections: Corrections<D>,
+    u_star: &[Vec<f64>; D],
+    dt: f64,
+    density_rate: f64,
+    b: &mut Vec<f64>,
+) {
+    let (nb, p) = (op.nb, op.p);
+    let g = op.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
+    b.resize(op.roles.len(), 0.0);
+    fill(b, |i| match op.roles[i] {
+        Role::Interior => divergence_source(
+            nb,
+            p,
+            corrections.of(i),
+            u_star,
+            full[i],
+            dt,
+            density_rate,
+            i,
+        ),
+        Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
+        Role::Splash | Role::Reference => 0.0,
+    });
+    let net = if closed {
+        net_compression(op.roles, b, b.len(), |k| k)
+    } else {
+        0.0
+    };
+    for region in sealed {
+        let net = net_compression(op.roles, b, region.len(), |k| region[k]);
+        for &i in region {
+            if op.roles[i] == Role::Interior {
+                b[i] -= net;
+            }
+        }
+    }
+    // The walls' known differences (the Neumann ghosts) complete the interior rows.
+    b.par_iter_mut()
+        .zip(op.roles)
+        .enumerate()
+        .for_each(|(i, (b, &role))| {
+            if role == Role::Interior {
+                *b = *b - net + op.wall_source(i);
+            }
+        });
+}
+
+/// In a closed box the interior rows' compression must sum to zero: the volume cannot change,
+/// and a net source would have nowhere to go but the reference particle's row (a spurious
+/// point source of pressure there). The SPH divergence and the density term leave a small net
+/// sum (from the disorder of the particles); its mean over the interior rows `b` (their
+/// compression only), which `source` removes from each. The walls' known differences are not
+/// compression and stay out of it: under gravity they are what holds the hydrostatic pressure
+/// up, and taking their net sum out as well drove a flow towards the reference (0.35 m/s after
+/// 0.5 s in a 0.5 × 0.4 m box full of water). Water sealed off from the free surface is such a
+/// box of its own: the mean is over the interior rows among `count` rows, row k being
+/// `row(k)`.
+fn net_compression(
+    roles: &[Role],
+    b: &[f64],
+    count: usize,
+    row: impl Fn(usize) -> usize + Sync,
+) -> f64 {
+    let [count, sum] = crate::math::reduce::sums(count, |k| {
+        let i = row(k);
+        if roles[i] == Role::Interior {
+            [1.0, b[i]]
+        } else {
+            [0.0; 2]
+        }
+    });
+    if count > 0.0 {
+        sum / count
+    } else {
+        0.0
+    }
+}
+
+/// −(ρ0/Δt) ∇·u* − α (ρ0 − ρ_i)/(Δt Δt_max), Eq. (6), with ∇·u* corrected by Eq. (24)–(25) so
+/// that it is exact for linear velocity fields also where the free surface truncates the kernel.
+/// `density_rate` is α/Δt_max. A full step (Δt = Δt_max) is Eq. (6) as printed; a step cut
+/// short to land on a frame relaxes the density error by the fraction α Δt/Δt_max of it, at
+/// the same rate per unit time. With α/Δt² the velocity the term corrects by grows as 1/Δt:
+/// a last step of 4e-8 s (an end time just past a frame) ended a dam break at 78 m/s.
+#[allow(clippy::too_many_arguments)]
+fn divergence_source<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Correction<D>,
+    u_star: &[Vec<f64>; D],
+    full_support: bool,
+    dt: f64,
+    density_rate: f64,
+    i: usize,
+) -> f64 {
+    let rho_i = p.density[i];
+    // Walls take the fluid's own u*_i less its normal velocity of the last step: the body force
+    // is carried by the wall ghosts' Neumann condition, the wall's kinematic condition by the
+    // divergence (see `wall::ghost_velocity`).
+    let u_star_i: [f64; D] = std::array::from_fn(|d| u_star[d][i]);
+    let u_i = p.velocity(i);
+    let velocity = |l: &Lanes<D>| -> [F64s; D] {
+        match l.kind {
+            Kind::Wall => ghost_velocity(p, l, u_star_i, u_i),
+            Kind::Fluid => std::array::from_fn(|d| l.load(&u_star[d])),
+        }
+    };
+    // ∇·u* = trace of the corrected velocity gradient, Eq. (22) with Eq. (24)–(25).
+    let grad_u = velocity_gradient(nb, p, l, u_star_i, velocity, i);
+    let div: f64 = (0..D).map(|a| grad_u[a][a]).sum();
+    let rho0 = p.rest_density[i];
+    // Where the free surface truncates the kernel the summation density is low because
+    // neighbours are missing, not because the fluid expanded: there only compression counts.
+    let density_deviation = if full_support {
+        rho0 - rho_i
+    } else {
+        (rho0 - rho_i).min(0.0)
+    };
+    let density_term = density_rate * density_deviation / dt;
+    -(rho0 / dt * div + density_term)
+}
+
+/// ρ0_i V_j, the mass of neighbour j's volume at i's rest density: m_j where the fluids share
+/// one (`interfaces` false), every neighbour counted as one of i's own fluid where they do not.
+#[inline(always)]
+fn volume_mass<const D: usize>(
+    p: &Particles<D>,
+    interfaces: bool,
+    row: &Side<D>,
+    l: &Lanes<D>,
+) -> F64s {
+    if interfaces {
+        mass_at_density(p, row.rest_density, l)
+    } else {
+        l.load(&p.mass)
+    }
+}
+
+/// First-order consistency of the Laplacian of Eq. (27). Where the free surface truncates the
+/// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with c_i = 2 Σ_j
+/// (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support; every neighbour counted as one
+/// of i's own fluid, m_j = ρ0_i V_j, where the fluids differ). A wall ghost continues only the
+/// normal part of the field, so a wall neighbour contributes N_b r_ij (see `wall`): beside a plane
+/// wall the wall supplies what the missing fluid would, but in a corner or where the surface meets
+/// a wall the support is truncated for the tangential part too. Subtracting that term, with ∇P_i
+/// the corrected gradient L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij − V_j
+/// (L_iᵀc_i)·∇W_ij)(P_i − P_j), still one pass over the neighbours. Without it the pressure bends
+/// under the free surface and pushes a still surface off its rest position. Returns ĉ_i = L_iᵀ c_i,
+/// with L_i the pressure gradient correction.
+fn laplacian_correction<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    interfaces: Option<Field<D>>,
+    l: &Correction<D>,
+    i: usize,
+) -> [f64; D] {
+    let mut c = [Sum::ZERO; D];
+    let scale = F64s::splat(2.0 / p.rest_density[i]);
+    let row = Side::of(p, interfaces, i);
+    nb.for_each_lanes(i, |lanes| {
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(lanes.r);
+        // −a_ij of Eq. (27) (`sph::laplacian_coefficient`) for the kernel's truncation alone:
+        // across an interface the pairs are weighted by design (`interior_weights`), and taken
+        // for truncation that weighting would be undone, leaving one fluid's pressure gradient
+        // through both.
+        let mass = volume_mass(p, interfaces.is_some(), &row, lanes);
+        let cl = (scale * mass * laplacian_factor) & lanes.mask;
+        let followed = match lanes.kind {
+            Kind::Fluid => lanes.rij,
+            Kind::Wall => behind_walls(p, lanes, lanes.rij),
+        };
+        for d in 0..D {
+            c[d] = c[d].mul_add(cl, followed[d]);
+        }
+    });
+    let c = c.map(|x| x.total());
+    match l {
+        Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[b][a] * c[b]).sum()),
+        None => c,
+    }
+}
+
+/// The PPE matrix A, applied on the fly from positions (no matrix, no per-pair list).
+pub struct PressureOperator<'a, const D: usize> {
+    pub nb: &'a Neighbours<'a, D>,
+    pub p: &'a Particles<D>,
+    pub roles: &'a [Role],
+    /// The row vectors of `row_vectors`.
+    pub row_vectors: &'a [Vec<f64>; D],
+    /// V_j = m_j/ρ0_j of the fluid particles, the unknowns the rows couple (`fluid_volumes`).
+    pub fluid_volume: &'a [f64],
+    pub gravity: [f64; D],
+    /// The gravity the wall ghosts' pressures carry (`StepSettings::ghost_gravity`).
+    pub ghost_gravity: [f64; D],
+    /// Where the fluids differ in rest density, each fluid particle's distance to the nearest
+    /// interface (`interior_weights`).
+    pub interfaces: Option<Field<'a, D>>,
+}
+
+/// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
+struct Row<const D: usize> {
+    scale: F64s,
+    c: [F64s; D],
+    /// ρ0_i and i's distance to the nearest interface.
+    density: Side<D>,
+}
+
+impl<const D: usize> PressureOperator<'_, D> {
+    fn row_constants(&self, i: usize) -> Row<D> {
+        Row {
+            scale: F64s::splat(-2.0 / self.p.rest_density[i]),
+            c: std::array::from_fn(|d| F64s::splat(self.row_vectors[d][i])),
+            density: Side::of(self.p, self.interfaces, i),
+        }
+    }
+
+    /// Weights of (P_i − P_j) in the interior row i (constants `row`) for the lanes `l`, with
+    /// `volume` the volumes V_j of the lanes: max(a_ij − V_j ĉ_i·∇W_ij, 0),
+    /// a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) of Eq. (27) (m_j = ρ0_i V_j where the
+    /// fluids differ: `volume_mass`). Across an interface between fluids of different rest
+    /// density the row is ρ0_i ∇·(∇P/ρ), with 1/ρ̄_ij across a pair, ρ̄_ij the density along
+    /// the segment between them (`interface::pair_weight`), which keeps ∇P/ρ continuous across
+    /// the interface and a stable layering at rest. The whole corrected coefficient is
+    /// weighted: the correction keeps the row exact for a field whose weighted differences are
+    /// linear, the hydrostatic pressure of a layering, also where a wall or the surface
+    /// truncates the support (with the coefficient alone weighted, the layering moved where
+    /// its interface meets a side wall).
+    #[inline(always)]
+    fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, volume: F64s) -> F64s {
+        let mass = volume_mass(self.p, self.interfaces.is_some(), &row.density, l);
+        // a_ij − V_j F ĉ_i·r_ij = k ((−2 m_j/ρ_i) r² − V_j (r² + η²) ĉ_i·r_ij), with
+        // F = k (r² + η²) and the Laplacian factor k r² (`RadialTerms`).
+        let radial = self.nb.radial_terms_lanes(l.r);
+        let c_r = (0..D).fold(F64s::ZERO, |s, d| row.c[d].mul_add(l.rij[d], s));
+        let correction = volume * radial.r2_eta2 * c_r;
+        let weight = radial.k * (row.scale * mass).mul_add(radial.r2, -correction);
+        let weight = row.density.across(self.p, self.interfaces, l, weight);
+        // Where the support is badly truncated (a surge tip, spray) the correction can turn a
+        // weight negative; clipped at zero the row keeps non-negative neighbour weights (an
+        // M-matrix row) and the solve no pressure spikes. Still water never needs the clip.
+        weight.fast_max(F64s::ZERO) & l.mask
+    }
+
+    /// The weights of interior row i with its fluid neighbours `l`.
+    #[inline(always)]
+    fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> F64s {
+        self.interior_weights(row, l, l.load(self.fluid_volume))
+    }
+
+    /// The wall part of the right-hand side of interior row i: the Neumann ghosts' known
+    /// differences.
+    fn wall_source(&self, i: usize) -> f64 {
+        let (p, row) = (self.p, self.row_constants(i));
+        let mut b = Sum::ZERO;
+        self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
+            let volume = l.load(&p.mass) / l.load(&p.rest_density);
+            let w = self.interior_weights(&row, l, volume);
+            b += w * ghost_pressure_difference(p, self.ghost_gravity, i, l);
+        });
+        b.total()
+    }
+
+    /// (A x)_i: the interior rows couple fluid neighbours only (the walls' pairs are known
+    /// numbers, in the right-hand side).
+    #[inline]
+    fn row(&self, x: &[f64], i: usize) -> f64 {
+        match self.roles[i] {
+            Role::Interior => {
+                let (xi, row) = (F64s::splat(x[i]), self.row_constants(i));
+                let mut ax = Sum::ZERO;
+                self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+                    ax = ax.mul_add(self.fluid_weights(&row, l), xi - l.load(x));
+                });
+                ax.total()
+            }
+            Role::Surface | Role::Splash | Role::Reference => x[i],
+        }
+    }
+}
+
+impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
+    fn len(&self) -> usize {
+        self.roles.len()
+    }
+
+    fn apply(&self, x: &[f64], y: &mut [f64]) {
+        fill(y, |i| self.row(x, i));
+    }
+
+    fn diagonal(&self, diag: &mut [f64]) {
+        fill(diag, |i| match self.roles[i] {
+            Role::Interior => {
+                let row = self.row_constants(i);
+                let mut d = Sum::ZERO;
+                self.nb
+                    .for_each_lanes_of(i, &[Kind::Fluid], |l| d += self.fluid_weights(&row, l));
+                interior_diagonal(d)
+            }
+            Role::Surface | Role::Splash | Role::Reference => 1.0,
+        })
+    }
+}
+
+impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
+    fn dims(&self) -> [usize; D] {
+        self.nb.grid().blocks()
+    }
+
+    fn aggregate(&self, i: usize) -> Option<usize> {
+        match self.roles[i] {
+            Role::Interior => Some(self.nb.grid().block_of_sorted(i)),
+            Role::Surface | Role::Splash | Role::Reference => None,
+        }
+    }
+
+    fn add_coarse_row(&self, i: usize, row: &mut [f64]) -> f64 {
+        // Interior rows: a_ii = Σ w, a_ij = −w; the other rows are not aggregated.
+        debug_assert_eq!(self.roles[i], Role::Interior, "row {i} is not aggregated");
+        let (grid, p) = (self.nb.grid(), self.p);
+        let block =
+            |j: usize| -> [i64; D] { std::array::from_fn(|d| grid.block_along(d, p.pos[d][j])) };
+        let (centre, block_i) = (stencil_slot([0; D]), block(i));
+        let constants = self.row_constants(i);
+        let mut diagonal = Sum::ZERO;
+        self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+            let w = self.fluid_weights(&constants, l);
+            diagonal += w;
+            for (k, w) in w.to_array().into_iter().enumerate() {
+                if w == 0.0 {
+                    continue;
+                }
+                row[centre] += w;
+                let j = l.j0 + k;
+                // A coupling across a periodic boundary joins blocks at the two ends of the
+                // grid, outside the 3^D stencil: the coarse levels leave it out (their row keeps
+                // its diagonal), which only weakens the preconditioner near that boundary.
+                let block_j = block(j);
+                let offset: [i64; D] = std::array::from_fn(|d| block_j[d] - block_i[d]);
+                if self.roles[j] == Role::Interior && offset.iter().all(|o| o.abs() <= 1) {
+                    row[stencil_slot(offset)] -= w;
+                }
+            }
+        });
+        interior_diagonal(diagonal)
+    }
+}
+
+/// a_ii of an interior row from the sum of its weights (`PressureOperator::interior_weights`):
+/// a row whose every weight was clipped holds its particle at P = 0.
+fn interior_diagonal(weights: Sum) -> f64 {
+    let d = weights.total();
+    if d > 0.0 {
+        d
+    } else {
+        1.0
+    }
+}

@@ -1,0 +1,445 @@
+//! SPH discretisation: the operators of Eq. (20)–(27) written as per-particle sums over the
+//! pair loop of `neighbours`.
+
+pub mod free_surface;
+pub mod interface;
+
+use crate::boundary::ghosts::{behind_walls, ghost_velocity, Face};
+use crate::math::kernel::Quintic;
+use crate::math::lanes::{F64s, Sum};
+use crate::math::lattice::for_each_lattice_point;
+use crate::neighbours::Lanes;
+use crate::neighbours::Neighbours;
+use crate::particles::{Kind, Particles};
+
+/// Summation density ρ_i = Σ_j m_j (ρ0_i/ρ0_j) W_ij = ρ0_i Σ_j V_j W_ij (self included): the
+/// familiar Σ_j m_j W_ij where the support holds one fluid, while across the interface of two
+/// fluids each neighbour counts with its volume (Hu & Adams 2006), so that water beside oil is not
+/// taken for expanded (below 0.9 ρ0 it would be spray: `free_surface::spray_density`) nor the oil
+/// for compressed.
+pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
+    let mut rho = Sum::ZERO;
+    let rho0_i = F64s::splat(p.rest_density[i]);
+    nb.for_each_lanes(i, |l| {
+        rho += (mass_at_density(p, rho0_i, l) * nb.kernel.w_lanes(l.r)) & l.mask;
+    });
+    p.mass[i] * nb.kernel.w(0.0) + rho.total()
+}
+
+/// m_j ρ0_i/ρ0_j = ρ0_i V_j of the lanes: the mass of neighbour j's volume at particle i's rest
+/// density, exactly m_j where the two share one (a wall takes the first fluid's).
+#[inline(always)]
+pub fn mass_at_density<const D: usize>(
+    p: &Particles<D>,
+    rest_density_i: F64s,
+    l: &Lanes<D>,
+) -> F64s {
+    l.load(&p.mass) * (rest_density_i / l.load(&p.rest_density))
+}
+
+/// V_j F(r_ij) of the lanes (zero in the masked ones), with V_j = m_j/ρ0_j: the weight of
+/// r_ij in the gradients of Eq. (20) and the moments of Eq. (25).
+#[inline(always)]
+pub fn volume_gradient_factor<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Lanes<D>,
+) -> F64s {
+    (l.load(&p.mass) / l.load(&p.rest_density) * nb.kernel.grad_factor_lanes(l.r)) & l.mask
+}
+
+/// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, ν_t the eddy viscosity
+/// of the Smagorinsky model (Eq. 3–4) where the scene runs LES (`eddy`; None: ν_t = 0). Wall
+/// particles take the fluid's laminar viscosity (the turbulent stress at a wall is the law of
+/// the wall's, `turbulence::wall_shear`) and the no-slip velocity of Morris, Fox & Zhu (1997),
+/// with `face` the nearest wall's in the kernel support (`wall::nearest_face`):
+/// u_b = −(d_b/d_i) u_i with d the distances to the wall face, which puts u = 0 on the face
+/// itself, so u_i − u_b = β u_i with β = 1 + d_b/d_i = n_b·r_ib/d_i, capped at
+/// `MORRIS_BETA_MAX` for the wall particles deep behind the face. (Walls simply at rest, β = 1, put
+/// the no-slip line about half a spacing behind the face: a Poiseuille channel 20 particles wide
+/// then flows 12% too fast.)
+pub fn viscous_acceleration<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    eddy: Option<&[f64]>,
+    face: Option<Face<D>>,
+    i: usize,
+) -> [f64; D] {
+    let (rho_i, nu_laminar) = (p.rest_density[i], p.viscosity[i]);
+    let nu_i = nu_laminar + eddy.map_or(0.0, |e| e[i]);
+    let d_i = F64s::splat(face.map_or(f64::INFINITY, |f| f.distance));
+    let u_i = p.velocity(i);
+    let mut acc = [Sum::ZERO; D];
+    nb.for_each_lanes(i, |l| {
+        let (nu_i, nu_j, du): (F64s, F64s, [F64s; D]) = match l.kind {
+            Kind::Wall => {
+                let n_r = (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s));
+                let beta = (n_r / d_i)
+                    .fast_max(F64s::ONE)
+                    .fast_min(F64s::splat(MORRIS_BETA_MAX));
+                let nu = F64s::splat(nu_laminar);
+                (nu, nu, u_i.map(|u| beta * F64s::splat(u)))
+            }
+            Kind::Fluid => {
+                let nu_t = eddy.map_or(F64s::ZERO, |e| l.load(e));
+                let du = std::array::from_fn(|d| F64s::splat(u_i[d]) - l.load(&p.vel[d]));
+                (F64s::splat(nu_i), l.load(&p.viscosity) + nu_t, du)
+            }
+        };
+        let (rho_j, rho_i) = (l.load(&p.rest_density), F64s::splat(rho_i));
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(l.r);
+        let c = (l.load(&p.mass) * rho_i.mul_add(nu_i, rho_j * nu_j) / (rho_i * rho_j)
+            * laplacian_factor)
+            & l.mask;
+        for d in 0..D {
+            acc[d] = acc[d].mul_add(c, du[d]);
+        }
+    });
+    acc.map(|a| a.total())
+}
+
+/// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right
+/// at the face (d_i → 0); here d_i ≥ dx/4 (`wall::Face::distance`) bounds β anyway, and a cap of
+/// 1.5 leaves the Poiseuille channel 4.2% too fast (4: 0.48%, no cap: 0.47%).
+const MORRIS_BETA_MAX: f64 = 4.0;
+
+/// Corrected gradient of a velocity field, G[b][a] = ∂u_a/∂x_b = Σ_c L_bc Σ_j V_j (u_j − u_i)_a ∂_c W_ij
+/// (Eq. 20 with Eq. 24–25), with `u_i` the velocity of particle i and `u(l)` the velocities
+/// taken for the neighbours in lanes `l`.
+pub fn velocity_gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Correction<D>,
+    u_i: [f64; D],
+    u: impl Fn(&Lanes<D>) -> [F64s; D],
+    i: usize,
+) -> [[f64; D]; D] {
+    let mut g = [[Sum::ZERO; D]; D];
+    nb.for_each_lanes(i, |lanes| {
+        let vf = volume_gradient_factor(nb, p, lanes);
+        let u_j = u(lanes);
+        for a in 0..D {
+            let du = vf * (u_j[a] - F64s::splat(u_i[a]));
+            for b in 0..D {
+                g[b][a] = g[b][a].mul_add(du, lanes.rij[b]);
+            }
+        }
+    });
+    let g = g.map(|row| row.map(|x| x.total()));
+    std::array::from_fn(|b| {
+        std::array::from_fn(|a| match l {
+            Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
+            None => g[b][a],
+        })
+    })
+}
+
+/// The velocities of the neighbours in lanes `l` in a velocity gradient at fluid particle i of
+/// velocity `u_i`: their own for fluid, the free-slip ghost of u_i for walls
+/// (`wall::ghost_velocity`).
+#[inline(always)]
+pub fn fluid_velocity<const D: usize>(p: &Particles<D>, u_i: [f64; D], l: &Lanes<D>) -> [F64s; D] {
+    match l.kind {
+        Kind::Fluid => std::array::from_fn(|d| l.load(&p.vel[d])),
+        Kind::Wall => ghost_velocity(p, l, u_i, u_i),
+    }
+}
+
+/// Smallest determinant of the moment matrix M_i for which the kernel gradient correction is
+/// applied at h/dx = `CORRECTION_H_OVER_DX`; below it (splashes, thin sheets, lone particles)
+/// the plain gradient is used. `min_correction_determinant` scales it to other h/dx.
+const MIN_CORRECTION_DETERMINANT: f64 = 0.1;
+/// The h/dx `MIN_CORRECTION_DETERMINANT` was set at.
+const CORRECTION_H_OVER_DX: f64 = 1.2;
+
+/// The smallest determinant of the moment matrix M'_i of the pressure gradient (`Moments::
+/// m_neumann`) for which the kernel gradient correction is applied, for the quintic at
+/// `h_over_dx`: 0.1 at h/dx = 1.2, scaled with the determinant of the most truncated support
+/// that must keep its correction, the top of the water where two side walls meet (in 2D,
+/// where the surface meets a wall). Its lattice determinant falls as the kernel reaches
+/// further (3D: 0.148 at h/dx = 1.2, 0.116 at 1.5, 0.098 at 1.8, 0.090 at 2.0), and a fixed 0.1
+/// took that particle for a splash from h/dx ≈ 1.75: its pressure went to 0, and the corners
+/// of still water in a 3D tank fell at 0.2 m/s.
+pub fn min_correction_determinant<const D: usize>(h_over_dx: f64) -> f64 {
+    MIN_CORRECTION_DETERMINANT
+        * (wall_corner_determinant::<D>(h_over_dx)
+            / wall_corner_determinant::<D>(CORRECTION_H_OVER_DX))
+}
+
+/// det M'_i at the top of the water in the corner of the walls, on a lattice of unit spacing:
+/// the particle at the origin, fluid where no index is positive, the walls where one of the
+/// first D − 1 indices is (at every height; each counts the offset along the axes it lies
+/// behind, `wall::behind_walls`), air above the water.
+fn wall_corner_determinant<const D: usize>(h_over_dx: f64) -> f64 {
+    let kernel = Quintic::<D>::new(h_over_dx);
+    let reach = kernel.support().ceil() as i64;
+    let mut m = [[0.0; D]; D];
+    for_each_lattice_point([-reach; D], [reach + 1; D], |k| {
+        let offset = k.map(|o| o as f64);
+        let r = offset.iter().map(|o| o * o).sum::<f64>().sqrt();
+        if r == 0.0 || r >= kernel.support() {
+            return;
+        }
+        let behind: [bool; D] = std::array::from_fn(|d| d < D - 1 && offset[d] >= 1.0);
+        let followed: [f64; D] = match (behind.iter().any(|&b| b), offset.iter().all(|&o| o <= 0.0))
+        {
+            (true, _) => std::array::from_fn(|d| if behind[d] { offset[d] } else { 0.0 }),
+            (false, true) => offset,
+            (false, false) => return,
+        };
+        // ∇_i W_ij ⊗ r_ji with r_ij = −offset.
+        let factor = kernel.grad_factor(r);
+        for a in 0..D {
+            for b in 0..D {
+                m[a][b] -= factor * offset[a] * followed[b];
+            }
+        }
+    });
+    invert(m).map_or(0.0, |(_, det)| det)
+}
+
+/// The moments of a fluid particle's kernel support, from one pass over its neighbours.
+#[derive(Clone, Copy, Debug)]
+pub struct Moments<const D: usize> {
+    /// M_i = Σ_j V_j ∇W_ij ⊗ r_ji of Eq. (25), walls included (symmetric; the identity for a
+    /// full support).
+    pub m: [[f64; D]; D],
+    /// M_i with each wall neighbour's r_bi replaced by its part across the walls, N_b r_bi:
+    /// the moment of a pressure field whose wall ghosts carry only the normal gradient (see
+    /// `wall`).
+    pub m_neumann: [[f64; D]; D],
+    /// ∇C_i = Σ_j V_j ∇W_ij, the concentration gradient.
+    pub grad_c: [f64; D],
+    /// The fluid particles in the kernel support.
+    pub fluid_neighbours: usize,
+}
+
+/// The support moments of particle i.
+pub fn support_moments<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> Moments<D> {
+    let (mut m, mut m_neumann) = ([[Sum::ZERO; D]; D], [[Sum::ZERO; D]; D]);
+    let (mut grad_c, mut fluid_neighbours) = ([Sum::ZERO; D], 0);
+    nb.for_each_lanes(i, |l| {
+        let vf = volume_gradient_factor(nb, p, l);
+        // The part of r_ij the pressure of j follows: all of it for fluid, the normal part for
+        // a wall ghost.
+        let followed = match l.kind {
+            Kind::Fluid => {
+                fluid_neighbours += l.count();
+                l.rij
+            }
+            Kind::Wall => behind_walls(p, l, l.rij),
+        };
+        for a in 0..D {
+            let v = vf * l.rij[a];
+            grad_c[a] += v;
+            for b in 0..D {
+                m[a][b] = m[a][b].mul_add(-v, l.rij[b]);
+                m_neumann[a][b] = m_neumann[a][b].mul_add(-v, followed[b]);
+            }
+        }
+    });
+    let sum = |x: [[Sum; D]; D]| x.map(|row| row.map(|v| v.total()));
+    Moments {
+        m: sum(m),
+        m_neumann: sum(m_neumann),
+        grad_c: grad_c.map(|v| v.total()),
+        fluid_neighbours,
+    }
+}
+
+/// Kernel gradient correction L_i = M_i⁻¹, Eq. (24)–(25), so that L_i Σ_j V_j (φ_j − φ_i) ∇W_ij
+/// is exact for linear φ even where the support is truncated. None where M_i is near-singular:
+/// its determinant at most `min_determinant` (`min_correction_determinant`).
+pub fn gradient_correction<const D: usize>(
+    m: [[f64; D]; D],
+    min_determinant: f64,
+) -> Correction<D> {
+    invert(m)
+        .filter(|(_, det)| *det > min_determinant)
+        .map(|(l, _)| l)
+}
+
+/// Inverse and determinant of a small matrix (Gauss–Jordan with partial pivoting).
+pub fn invert<const D: usize>(mut m: [[f64; D]; D]) -> Option<([[f64; D]; D], f64)> {
+    let mut inv = [[0.0; D]; D];
+    for (k, row) in inv.iter_mut().enumerate() {
+        row[k] = 1.0;
+    }
+    let mut det = 1.0;
+    for c in 0..D {
+        let pivot = (c..D).max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()))?;
+        if m[pivot][c] == 0.0 {
+            return None;
+        }
+        if pivot != c {
+            m.swap(pivot, c);
+            inv.swap(pivot, c);
+            det = -det;
+        }
+        let d = m[c][c];
+        det *= d;
+        for k in 0..D {
+            m[c][k] /= d;
+            inv[c][k] /= d;
+        }
+        for r in (0..D).filter(|&r| r != c) {
+            let f = m[r][c];
+            for k in 0..D {
+                m[r][k] -= f * m[c][k];
+                inv[r][k] -= f * inv[c][k];
+            }
+        }
+    }
+    Some((inv, det))
+}
+
+/// L_i of Eq. (25), or None where the correction is not applied.
+pub type Correction<const D: usize> = Option<[[f64; D]; D]>;
+
+/// The corrections L_i of the particles: every particle's (`dense`), only those of the
+/// particles that have one (`sparse`: a slot per particle into a list), or the identity for all
+/// of them where the scene turns the kernel correction off (then no array of them exists).
+#[derive(Clone, Copy, Debug)]
+pub struct Corrections<'a, const D: usize>(Option<Stored<'a, D>>);
+
+#[derive(Clone, Copy, Debug)]
+enum Stored<'a, const D: usize> {
+    Dense(&'a [Correction<D>]),
+    Sparse {
+        slot: &'a [u32],
+        list: &'a [Correction<D>],
+    },
+}
+
+/// The slot of a particle with no correction in a sparse `Corrections`.
+pub const NO_SLOT: u32 = u32::MAX;
+
+impl<'a, const D: usize> Corrections<'a, D> {
+    /// `l` (one per particle) where the correction is `on`, else the identity everywhere.
+    pub fn new(on: bool, l: &'a [Correction<D>]) -> Self {
+        Self(on.then_some(Stored::Dense(l)))
+    }
+
+    /// `list[slot[i]]` for the particles with a slot, the identity for the others (`NO_SLOT`)
+    /// and for all where the correction is off.
+    pub fn sparse(on: bool, slot: &'a [u32], list: &'a [Correction<D>]) -> Self {
+        Self(on.then_some(Stored::Sparse { slot, list }))
+    }
+
+    /// L_i.
+    #[inline]
+    pub fn of(self, i: usize) -> &'a Correction<D> {
+        match self.0 {
+            Some(Stored::Dense(l)) => &l[i],
+            Some(Stored::Sparse { slot, list }) => match slot[i] {
+                NO_SLOT => &None,
+                k => &list[k as usize],
+            },
+            None => &None,
+        }
+    }
+}
+
+/// Applies L_i to a vector (identity where the correction is off).
+#[inline]
+pub fn apply_correction<const D: usize>(l: &Correction<D>, v: [f64; D]) -> [f64; D] {
+    match l {
+        Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[a][b] * v[b]).sum()),
+        None => v,
+    }
+}
+
+/// Smallest det C / (tr C / D)^D of the neighbours' positions for which `fitted_value` fits
+/// a linear function: 1 for an isotropic spread, 0.77 for a particle on a flat free surface,
+/// 0.63 in a sheet two particles thick (2D lattice, h = 1.2 dx), 0 on a line.
+const MIN_FIT_ISOTROPY: f64 = 0.01;
+
+/// φ̃_i, the value at x_i of the linear function φ̄ + b·(x − x̄) fitted to the values φ_j
+/// (`values`) of the fluid neighbours of i's own fluid (same rest density: across an interface
+/// the hydrostatic pressure bends) by least squares weighted by W_ij, particle i itself left
+/// out; x̄ and φ̄ are their weighted means and b = C⁻¹ Σ_j W_ij (x_j − x̄)(φ_j − φ̄), C their
+/// weighted covariance. None where the neighbours do not fix a linear function: fewer than
+/// D + 1 of them, or spread along too few directions (a thin sheet, a line of particles):
+/// det C below `MIN_FIT_ISOTROPY` of (tr C / D)^D, the value of an isotropic spread.
+/// Exact for linear φ, like φ_i, but blind to φ_i itself (see `step::pressure_reference`).
+pub fn fitted_value<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    values: &[f64],
+    i: usize,
+) -> Option<f64> {
+    let own_fluid = F64s::splat(p.rest_density[i]);
+    // Weighted sums of 1, d = x_j − x_i, φ, d dᵀ and d φ.
+    let (mut w_sum, mut phi_sum) = (Sum::ZERO, Sum::ZERO);
+    let mut d_sum = [Sum::ZERO; D];
+    let mut dd_sum = [[Sum::ZERO; D]; D];
+    let mut dphi_sum = [Sum::ZERO; D];
+    nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+        let same = l.load(&p.rest_density).simd_eq(own_fluid);
+        let w = nb.kernel.w_lanes(l.r) & l.mask & same;
+        let phi = l.load(values) & l.mask;
+        w_sum += w;
+        phi_sum = phi_sum.mul_add(w, phi);
+        for a in 0..D {
+            let wd = -w * l.rij[a];
+            d_sum[a] += wd;
+            dphi_sum[a] = dphi_sum[a].mul_add(wd, phi);
+            for b in a..D {
+                dd_sum[a][b] = dd_sum[a][b].mul_add(wd, -l.rij[b]);
+            }
+        }
+    });
+    let w = w_sum.total();
+    let d_mean = d_sum.map(|x| x.total() / w);
+    let phi_mean = phi_sum.total() / w;
+    let covariance: [[f64; D]; D] = std::array::from_fn(|a| {
+        std::array::from_fn(|b| dd_sum[a.min(b)][a.max(b)].total() - w * d_mean[a] * d_mean[b])
+    });
+    let cross: [f64; D] = std::array::from_fn(|a| dphi_sum[a].total() - w * d_mean[a] * phi_mean);
+    let spread = (0..D).map(|a| covariance[a][a]).sum::<f64>() / D as f64;
+    let (inverse, det) = invert(covariance)?;
+    let spans = w > 0.0 && det > MIN_FIT_ISOTROPY * spread.powi(D as i32);
+    if !spans {
+        return None;
+    }
+    let slope = apply_correction(&Some(inverse), cross);
+    Some(phi_mean - (0..D).map(|a| slope[a] * d_mean[a]).sum::<f64>())
+}
+
+/// Corrected gradient of a scalar field, ∇φ_i = L_i Σ_j V_j (φ_j − φ_i) ∇W_ij, Eq. (20) with
+/// Eq. (24)–(25), with `difference(l)` = φ_j − φ_i of the neighbours in lanes `l`: exact for
+/// linear φ also where the kernel support is truncated.
+#[inline]
+pub fn gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Correction<D>,
+    i: usize,
+    difference: impl Fn(&Lanes<D>) -> F64s,
+) -> [f64; D] {
+    let mut grad = [Sum::ZERO; D];
+    nb.for_each_lanes(i, |lanes| {
+        let c = volume_gradient_factor(nb, p, lanes) * difference(lanes);
+        for d in 0..D {
+            grad[d] = grad[d].mul_add(c, lanes.rij[d]);
+        }
+    });
+    apply_correction(l, grad.map(|g| g.total()))
+}
+
+/// Coefficient a_ij ≥ 0 of the negative Laplacian of Eq. (27):
+/// −∇²P_i = Σ_j a_ij (P_i − P_j), a_ij = −(2 m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²).
+#[inline]
+pub fn laplacian_coefficient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+    j: usize,
+    r: f64,
+) -> f64 {
+    -2.0 * p.mass[j] / p.rest_density[i] * nb.laplacian_factor(r)
+}
