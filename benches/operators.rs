@@ -4,8 +4,8 @@
 //! preconditioner of the step (fluid particles/s), and a full `Simulation` step (fluid
 //! particles/s).
 //!
-//! The PPE operator is rebuilt from the state through the public API (`isph::tools::bench::PpeSetup`:
-//! the step's roles, row vectors zero, so each pair costs the step's arithmetic).
+//! The PPE operator is the step's own, built by its stages on the settled state
+//! (`Simulation::probe_pressure_operator`).
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use isph::math::reduce::fill;
@@ -15,7 +15,7 @@ use isph::simulation::Simulation;
 use isph::solver::krylov::{BiCgStab, LinearOperator, Preconditioner, SolverParams};
 use isph::solver::multigrid::Multigrid;
 use isph::sph;
-use isph::tools::bench::{dam_break_scene, PpeSetup};
+use isph::tools::bench::{apply_pairs, dam_break_scene};
 use std::time::Duration;
 
 /// Steps taken before the state is benched: past the PPE's cold start from rest.
@@ -27,32 +27,28 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
     for _ in 0..SETTLE_STEPS {
         sim.advance_towards(scene.end_time).unwrap();
     }
-    let gravity = std::array::from_fn(|d| scene.gravity[d]);
-    let kernel = sim.kernel();
-    // A copy for the operator benches; `sim` goes on for the step bench.
-    let mut p = sim.particles.clone();
-    let setup = PpeSetup::new(&mut p, kernel);
-    let nb = setup.neighbours(&p, kernel);
-    let op = setup.operator(&nb, &p, gravity);
-    let (n, fluid) = (p.len(), p.fluid_count());
+    let gravity: [f64; D] = std::array::from_fn(|d| scene.gravity[d]);
+    let (n, fluid) = (sim.particles.len(), sim.particles.fluid_count());
     let label = |what: &str| format!("{what}_{fluid}_fluid_{n}_particles");
     let mut g = c.benchmark_group(format!("{D}d"));
+    sim.probe_pressure_operator(|op| {
+    let (nb, p) = (op.nb, op.p);
 
     g.throughput(Throughput::Elements(n as u64));
-    let mut grid = setup.grid.clone();
+    let mut grid = nb.grid().clone();
     let (mut cells, mut order) = (Vec::new(), Vec::new());
     g.bench_function(label("cell_sort"), |b| {
         b.iter(|| grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap())
     });
 
     g.sample_size(50)
-        .throughput(Throughput::Elements(fluid_pairs(&nb, &p) as u64));
+        .throughput(Throughput::Elements(fluid_pairs(nb, p) as u64));
     let mut density = vec![0.0; n];
     g.bench_function(label("pair_loop_density"), |b| {
         b.iter(|| {
             fill(&mut density, |i| {
                 if p.is_fluid(i) {
-                    sph::density(&nb, &p, i)
+                    sph::density(nb, p, i)
                 } else {
                     0.0
                 }
@@ -60,7 +56,7 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
         })
     });
 
-    g.throughput(Throughput::Elements(setup.pairs(&nb) as u64));
+    g.throughput(Throughput::Elements(apply_pairs(op) as u64));
     let x = p.pressure[..op.len()].to_vec();
     let mut y = vec![0.0; op.len()];
     g.bench_function(label("ppe_apply"), |b| b.iter(|| op.apply(&x, &mut y)));
@@ -82,9 +78,9 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
         Multigrid::<D>::default(),
         vec![0.0; fluid],
     );
-    multigrid.setup(&op).unwrap();
+    multigrid.setup(op).unwrap();
     let info = solver
-        .solve(&op, &mut multigrid, &rhs, &mut solution, params)
+        .solve(op, &mut multigrid, &rhs, &mut solution, params)
         .unwrap();
     eprintln!(
         "{D}d: BiCGSTAB + multigrid from zero to the hydrostatic pressure: {} iterations, relative residual {:.1e}",
@@ -97,12 +93,14 @@ fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
     g.bench_function(label("bicgstab_solve"), |b| {
         b.iter(|| {
             solution.fill(0.0);
-            multigrid.setup(&op).unwrap();
+            multigrid.setup(op).unwrap();
             solver
-                .solve(&op, &mut multigrid, &rhs, &mut solution, params)
+                .solve(op, &mut multigrid, &rhs, &mut solution, params)
                 .unwrap()
         })
     });
+    })
+    .unwrap();
 
     g.bench_function(label("step"), |b| {
         b.iter(|| sim.advance_towards(scene.end_time).unwrap())

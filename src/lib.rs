@@ -26,9 +26,11 @@ pub mod sph;
 pub mod step;
 pub mod tools;
 
-pub use run::resume;
+// The facade: what the command line (`main.rs`) and a program driving isph use.
 pub use run::resume::ResumeOptions;
-pub use run::{run, RunError, RunOptions, RunSummary, StopSignal};
+pub use run::{resume, run, RunError, RunOptions, RunSummary, StopSignal};
 pub use scene::{Scene, SceneError};
 pub use simulation::{NoFluid, NumericalFailure, Simulation};
+pub use tools::child::RunReport;
 pub use tools::plan::Plan;
+pub use tools::{bench, study, validation};

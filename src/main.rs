@@ -2,13 +2,13 @@
 
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand};
-use isph::run::resume::{self, ResumeOptions};
-use isph::run::{run, RunError, RunOptions, StopSignal};
-use isph::scene::Scene;
-use isph::tools::bench::{self, BenchOptions, Schedule};
-use isph::tools::child::RunReport;
-use isph::tools::plan::Plan;
-use isph::tools::study::{plot, StudyOptions};
+use isph::bench::{self, BenchOptions, Schedule};
+use isph::resume::{self, ResumeOptions};
+use isph::study::{plot, StudyOptions};
+use isph::Plan;
+use isph::RunReport;
+use isph::Scene;
+use isph::{run, RunError, RunOptions, StopSignal};
 use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::flag;
 use std::io::Write;
@@ -239,7 +239,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 quiet,
                 stop,
             };
-            let summary = isph::run::resume(&located.checkpoint, &opts)?;
+            let summary = isph::resume(&located.checkpoint, &opts)?;
             let state = &located.checkpoint.state;
             outln!(
                 "resumed {} at step {} (t = {} s, last Δt = {:e} s): {} more steps to t = {} s in {:.1} s wall ({:.1} PPE iterations/step), {} frames in all, checkpoint {}",
@@ -267,9 +267,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             scene,
             run,
         } => {
-            let case: isph::tools::validation::Case = measure.parse()?;
+            let case: isph::validation::Case = measure.parse()?;
             let scene = Scene::load(&scene)?;
-            let measured = isph::tools::validation::measure(case, &scene, &run)?;
+            let measured = isph::validation::measure(case, &scene, &run)?;
             outln!("error = {:e}", measured.error);
             for (name, value) in &measured.details {
                 outln!("{name} = {value:e}");
@@ -286,7 +286,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             let exe = std::env::current_exe().context("locating the isph executable")?;
             let opts = StudyOptions { out, threads };
-            let summary = isph::tools::study::run(&study, &opts, &exe, |line| eprintln!("{line}"))?;
+            let summary = isph::study::run(&study, &opts, &exe, |line| eprintln!("{line}"))?;
             out!("{}", plot::table(&summary.outcomes));
             if summary.complete {
                 outln!(

@@ -145,6 +145,15 @@ impl<const D: usize> Particles<D> {
         std::array::from_fn(|d| self.normal[d][i])
     }
 
+    /// |u_i|.
+    #[inline]
+    pub fn speed(&self, i: usize) -> f64 {
+        (0..D)
+            .map(|d| self.vel[d][i] * self.vel[d][i])
+            .sum::<f64>()
+            .sqrt()
+    }
+
     #[inline]
     pub fn is_fluid(&self, i: usize) -> bool {
         self.kind[i] == Kind::Fluid

@@ -1,44 +1,22 @@
-//! The state of a run and its time stepping: the cell sort, the time-step limits, the
-//! projection step of `step`, and the diagnostics of each step.
+//! The state of a run and its time stepping: the particles, the simulated time and the step
+//! count (what a checkpoint holds), advanced by the stages of `step`.
 
-use crate::boundary::faces::{Contact, Faces};
+use crate::boundary::faces::Faces;
 use crate::fill;
+use crate::io::stats::StepStats;
 use crate::math::kernel::{Quintic, SUPPORT_IN_H};
 use crate::math::memory::ArraySize;
-use crate::math::reduce;
 use crate::neighbours::cell_list::CellList;
 use crate::particles::Particles;
-use crate::scene::{GhostPressure, Scene};
+use crate::scene::Scene;
 use crate::solver::krylov::{SolverError, SolverParams};
+use crate::solver::ppe::PressureOperator;
 use crate::sph;
 use crate::sph::free_surface;
 use crate::sph::interface::Interfaces;
-use crate::step::timings::{Stage, Timings};
-use crate::step::{speed, StepLength, StepReport, StepSettings, Workspace};
-use std::time::Instant;
-
-/// Viscous time-step limit Δt ≤ C_ν h²/ν.
-const VISCOUS_NUMBER: f64 = 0.125;
-/// Body-force time-step limit Δt ≤ C_g √(h/|g|).
-const BODY_FORCE_NUMBER: f64 = 0.25;
-
-/// A CFL time step below this fraction of the body-force step is a blow-up.
-const COLLAPSE_FRACTION: f64 = 1.0e-3;
-
-/// What one step measured: a row of `stats.csv` (without the wall time).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepStats {
-    pub step: u64,
-    pub time: f64,
-    pub dt: f64,
-    pub ppe_iterations: usize,
-    pub ppe_residual: f64,
-    pub max_speed: f64,
-    pub kinetic_energy: f64,
-    pub density_error: f64,
-    pub penetrations: usize,
-    pub disorder: f64,
-}
+use crate::step::time_step::{self, Limit};
+use crate::step::timings::Timings;
+use crate::step::{Step, StepError, StepSettings};
 
 #[derive(Debug, thiserror::Error)]
 pub enum NumericalFailure {
@@ -73,20 +51,12 @@ pub struct NoFluid {
 }
 
 pub struct Simulation<const D: usize> {
+    /// The lasting state: what a checkpoint holds, with `time` and `step`.
     pub particles: Particles<D>,
     pub time: f64,
     pub step: u64,
-    kernel: Quintic<D>,
-    grid: CellList<D>,
-    settings: StepSettings<D>,
-    faces: Faces,
-    cfl: f64,
-    max_viscosity: f64,
-    /// Arrays of the cell sort: cell of each particle, the sorting permutation, scratch.
-    cell_of: Vec<u32>,
-    order: Vec<u32>,
-    scratch: Vec<f64>,
-    work: Workspace<D>,
+    /// The stages of a step and their scratch.
+    stepper: Step<D>,
     /// Time spent in each stage so far.
     pub timings: Timings,
 }
@@ -112,231 +82,127 @@ impl<const D: usize> Simulation<D> {
         let margin = |d: usize| if periodic[d] { 0.0 } else { walls };
         let lo = std::array::from_fn(|d| scene.container.min[d] - margin(d));
         let hi = std::array::from_fn(|d| scene.container.max[d] + margin(d));
+        let settings = StepSettings {
+            gravity: std::array::from_fn(|d| scene.gravity[d]),
+            ghost_pressure: scene.walls.ghost_pressure,
+            spacing: scene.spacing,
+            alpha: scene.solver.alpha,
+            solver: SolverParams {
+                tolerance: scene.solver.tolerance,
+                max_iterations: scene.solver.max_iterations,
+            },
+            effects: scene.effects,
+            confined,
+            spray_density: free_surface::spray_density::<D>(scene.solver.h_over_dx),
+            min_correction_determinant: sph::min_correction_determinant::<D>(
+                scene.solver.h_over_dx,
+            ),
+            cfl: scene.solver.cfl,
+            max_viscosity: scene.fluids.iter().map(|f| f.viscosity).fold(0.0, f64::max),
+        };
+        let kernel = Quintic::new(h);
+        let interfaces = scene
+            .has_interfaces()
+            .then(|| Interfaces::new(&kernel, scene.spacing));
+        let stepper = Step::new(
+            settings,
+            kernel,
+            Faces::new(&scene.container, &scene.periodic, &scene.obstacles),
+            CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
+            interfaces,
+        );
+        let timings = Timings::new(stepper.stages().iter().map(|s| s.name()));
         Ok(Self {
             particles,
             time: 0.0,
             step: 0,
-            kernel: Quintic::new(h),
-            grid: CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
-            settings: StepSettings {
-                gravity: std::array::from_fn(|d| scene.gravity[d]),
-                ghost_gravity: match scene.walls.ghost_pressure {
-                    GhostPressure::Hydrostatic => std::array::from_fn(|d| scene.gravity[d]),
-                    GhostPressure::Mirror => [0.0; D],
-                },
-                spacing: scene.spacing,
-                alpha: scene.solver.alpha,
-                solver: SolverParams {
-                    tolerance: scene.solver.tolerance,
-                    max_iterations: scene.solver.max_iterations,
-                },
-                effects: scene.effects,
-                confined,
-                spray_density: free_surface::spray_density::<D>(scene.solver.h_over_dx),
-                min_correction_determinant: sph::min_correction_determinant::<D>(
-                    scene.solver.h_over_dx,
-                ),
-            },
-            faces: Faces::new(scene),
-            cfl: scene.solver.cfl,
-            max_viscosity: scene.fluids.iter().map(|f| f.viscosity).fold(0.0, f64::max),
-            cell_of: Vec::new(),
-            order: Vec::new(),
-            scratch: Vec::new(),
-            work: Workspace::new(
-                scene
-                    .has_interfaces()
-                    .then(|| Interfaces::new(&Quintic::<D>::new(h), scene.spacing)),
-            ),
-            timings: Timings::default(),
+            stepper,
+            timings,
         })
     }
 
     pub fn kernel(&self) -> Quintic<D> {
-        self.kernel
+        self.stepper.kernel()
     }
 
-    /// Largest stable Δt: CFL, viscous and body-force limits. A CFL step far below the
-    /// body-force step means the flow has blown up: that is reported, not integrated (without
-    /// gravity there is no such reference, and only a non-finite velocity stops the run).
-    pub fn time_step_limit(&self) -> Result<f64, NumericalFailure> {
-        let p = &self.particles;
-        let h = self.kernel.h();
-        let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { speed(p, i) } else { 0.0 });
-        let g = self
-            .settings
-            .gravity
-            .iter()
-            .map(|g| g * g)
-            .sum::<f64>()
-            .sqrt();
-        let (cfl, body_force) = (self.cfl * h / max_speed, BODY_FORCE_NUMBER * (h / g).sqrt());
-        let dt = cfl
-            .min(body_force)
-            .min(VISCOUS_NUMBER * h * h / self.max_viscosity);
-        if body_force.is_finite() && cfl < COLLAPSE_FRACTION * body_force {
-            return Err(NumericalFailure::TimeStepCollapse {
-                step: self.step,
-                time: self.time,
-                dt,
-                max_speed,
-            });
-        }
-        Ok(dt)
+    /// The stages of a step and their scratch.
+    pub fn stepper(&self) -> &Step<D> {
+        &self.stepper
     }
 
-    /// Re-sorts the particles by cell, permuting every array together; particles that left
-    /// through a periodic boundary come back through the opposite one first.
-    fn sort_by_cell(&mut self) -> Result<(), NumericalFailure> {
-        let clock = Instant::now();
-        // (A no-op after a step; a checkpoint written before steps wrapped may hold positions
-        // past the period.)
-        self.grid.wrap(&mut self.particles.pos);
-        if let Err(out) = self.grid.sort(
-            &self.particles.pos,
-            &self.particles.kind,
-            &mut self.cell_of,
-            &mut self.order,
-        ) {
-            let p = &self.particles;
-            return Err(NumericalFailure::LeftDomain {
-                id: p.id[out.index],
-                step: self.step,
-                time: self.time,
-                position: p.position(out.index).to_vec(),
-            });
-        }
-        self.particles.permute(&self.order, &mut self.scratch);
-        self.timings.add(Stage::CellList, clock.elapsed());
-        Ok(())
+    /// Largest stable Δt of the particles as they are, and the condition that sets it
+    /// (`time_step::limiting`).
+    pub fn time_step_limit(&self) -> Result<(f64, Limit), NumericalFailure> {
+        time_step::limiting(&self.particles, self.kernel().h(), &self.stepper.settings)
+            .map_err(|e| self.failure(e))
     }
 
     /// Advances by one step towards the simulated time `target` (the next frame's), landing on
-    /// it exactly when it is within reach (two steps to go are split evenly, so no step is
-    /// tiny). The step that lands on it also computes the wall particles' pressure for the
-    /// frame.
+    /// it exactly when it is within reach (`Step::advance`).
     pub fn advance_towards(&mut self, target: f64) -> Result<StepStats, NumericalFailure> {
-        self.sort_by_cell()?;
-        let limit = self.time_step_limit()?;
-        let remaining = target - self.time;
-        let dt = if remaining <= limit {
-            remaining
-        } else if remaining < 2.0 * limit {
-            0.5 * remaining
-        } else {
-            limit
-        };
-        let lands_on_target = dt == remaining;
-        let (step, time) = (self.step, self.time);
-        let report = self
-            .work
-            .project(
-                &mut self.particles,
-                &self.grid,
-                self.kernel,
-                &self.settings,
-                &self.faces,
-                StepLength { dt, limit },
-                lands_on_target,
-                &mut self.timings,
-            )
-            .map_err(|source| NumericalFailure::Solver { step, time, source })?;
-        self.time = if lands_on_target {
+        let report =
+            self.stepper
+                .advance(&mut self.particles, self.time, target, &mut self.timings);
+        let report = report.map_err(|e| self.failure(e))?;
+        self.time = if report.lands_on_target {
             target
         } else {
-            self.time + dt
+            self.time + report.length.dt
         };
-        let penetrations = self.keep_off_the_faces();
-        // Along a periodic axis a particle leaves the period only in the advection: wrapped
-        // back here, the frames and checkpoints hold every position inside the box.
-        self.grid.wrap(&mut self.particles.pos);
-        self.finish_step(dt, report, penetrations)
-    }
-
-    fn finish_step(
-        &mut self,
-        dt: f64,
-        report: StepReport,
-        penetrations: usize,
-    ) -> Result<StepStats, NumericalFailure> {
-        let clock = Instant::now();
         self.step += 1;
-        let p = &self.particles;
-        let fluid = |i: usize| p.is_fluid(i);
-        let max_speed = reduce::max(p.len(), |i| if fluid(i) { speed(p, i) } else { 0.0 });
-        if !max_speed.is_finite() {
-            return Err(NumericalFailure::NonFinite {
-                step: self.step,
-                time: self.time,
-            });
-        }
-        let kinetic_energy = reduce::sum(p.len(), |i| {
-            if fluid(i) {
-                0.5 * p.mass[i] * speed(p, i).powi(2)
-            } else {
-                0.0
-            }
-        });
-        let stats = StepStats {
+        Ok(StepStats {
             step: self.step,
             time: self.time,
-            dt,
+            dt: report.length.dt,
             ppe_iterations: report.solve.iterations,
             ppe_residual: report.solve.relative_residual,
-            max_speed,
-            kinetic_energy,
+            max_speed: report.max_speed,
+            kinetic_energy: report.kinetic_energy,
             density_error: report.density_error,
-            penetrations,
+            penetrations: report.penetrations,
             disorder: report.disorder,
-        };
-        self.timings.add(Stage::Diagnostics, clock.elapsed());
-        Ok(stats)
+        })
     }
 
-    /// Every per-particle array of the step with the stage that allocates it, as it is now:
-    /// the cell sort's and the workspace's (`Workspace::arrays`). The particles' own arrays are
-    /// `Particles::arrays_mut`.
-    pub fn arrays(&self) -> Vec<(Stage, ArraySize)> {
-        let sort = [
-            ArraySize::of("cell of particle", &self.cell_of),
-            ArraySize::of("sort order", &self.order),
-            ArraySize::of("sort scratch", &self.scratch),
-            self.grid.sorted_cells(),
-        ];
-        let runs = self.grid.runs_arrays();
-        let mut arrays: Vec<_> = sort
-            .into_iter()
-            .chain(runs)
-            .map(|a| (Stage::CellList, a))
-            .collect();
-        arrays.extend(self.work.arrays());
-        arrays
+    /// Sorts the particles and hands `probe` the PPE operator of their state
+    /// (`Step::probe_pressure_operator`).
+    pub fn probe_pressure_operator<R>(
+        &mut self,
+        probe: impl FnOnce(&PressureOperator<D>) -> R,
+    ) -> Result<R, NumericalFailure> {
+        let probed = self
+            .stepper
+            .probe_pressure_operator(&mut self.particles, probe);
+        probed.map_err(|e| self.failure(e))
     }
 
-    /// `Faces::contact` for every fluid particle, a quarter spacing off the faces (at rest
-    /// the fluid sits half a spacing off them). Returns the penetrations the step's advection
-    /// made, counted before the contact puts them back: the particles the walls' pressure did
-    /// not stop. Timed as part of the advection.
-    fn keep_off_the_faces(&mut self) -> usize {
-        let clock = Instant::now();
-        let gap = 0.25 * self.settings.spacing;
-        let p = &mut self.particles;
-        let mut penetrations = 0;
-        for i in 0..p.len() {
-            if !p.is_fluid(i) {
-                continue;
-            }
-            let (mut x, mut u) = (p.position(i), p.velocity(i));
-            match self.faces.contact(gap, &mut x, &mut u) {
-                Contact::Clear => continue,
-                Contact::Near => {}
-                Contact::Crossed => penetrations += 1,
-            }
-            for d in 0..D {
-                (p.pos[d][i], p.vel[d][i]) = (x[d], u[d]);
-            }
+    /// The failure of a step, at this step and time.
+    fn failure(&self, e: StepError) -> NumericalFailure {
+        let (step, time) = (self.step, self.time);
+        match e {
+            StepError::LeftDomain { index } => NumericalFailure::LeftDomain {
+                id: self.particles.id[index],
+                step,
+                time,
+                position: self.particles.position(index).to_vec(),
+            },
+            StepError::Collapse { dt, max_speed } => NumericalFailure::TimeStepCollapse {
+                step,
+                time,
+                dt,
+                max_speed,
+            },
+            StepError::Solver(source) => NumericalFailure::Solver { step, time, source },
+            StepError::NonFinite => NumericalFailure::NonFinite {
+                step: step + 1,
+                time,
+            },
         }
-        self.timings.add_part(Stage::Advection, clock.elapsed());
-        penetrations
+    }
+
+    /// Every per-particle array of the step with the stage that holds it, as it is now
+    /// (`Step::arrays`). The particles' own arrays are `Particles::arrays_mut`.
+    pub fn arrays(&self) -> Vec<(&'static str, ArraySize)> {
+        self.stepper.arrays()
     }
 }

@@ -53,6 +53,12 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             &["simulation.spacing", "scene.toml:3", "positive"],
         ),
         (
+            // A number prints in the shortest form that reads back, not in 300 digits.
+            "spacing = 0.02",
+            "spacing = -1e-300",
+            &["simulation.spacing", "= -1e-300 must be a positive number"],
+        ),
+        (
             "output_interval = 0.01",
             "output_interval = 1e-12",
             &["simulation.output_interval", "scene.toml:5", "frames"],
@@ -251,4 +257,47 @@ fn a_block_one_spacing_wide_is_accepted() {
     let scene = crate::common::scene_from_text(&text);
     let plan = isph::tools::plan::Plan::new(&scene).unwrap_or_else(|e| panic!("{e}"));
     assert!(plan.to_string().contains("particles: 1 fluid"), "{plan}");
+}
+
+#[test]
+fn a_run_of_more_than_ten_million_steps_is_warned_of_with_the_limit_that_sets_the_step() {
+    use std::io::{BufRead, BufReader};
+    let dir = TempDir::new("long-run");
+    // ν = 1e6 m²/s: Δt = 0.125 h²/ν = 7.2e-11 s (h = 0.024 m), 9.7e9 steps to 0.7 s.
+    let text = good().replace("viscosity = 1.0e-6", "viscosity = 1.0e6");
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("out");
+    let mut child = isph_command()
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ])
+        .args(["--until", "0.7"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The warning comes before the first step; the run itself is not waited for.
+    let mut first = String::new();
+    BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        first.starts_with("warning: the first time step is"),
+        "{first}"
+    );
+    assert!(first.contains("the viscous condition"), "{first}");
+    assert!(
+        first.contains("reaching t = 0.7 s takes about 9.7e9 steps"),
+        "{first}"
+    );
+    // A run of ordinary length is not warned of.
+    let (code, stderr) = run_text(dir.path(), &good(), &["--until", "0.01", "--overwrite"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
 }

@@ -1,4 +1,4 @@
-//! Free-surface detection (src/free_surface.rs) on blocks, a tank, sheets and a lone particle,
+//! Free-surface detection (src/sph/free_surface.rs) on blocks, a tank, sheets and a lone particle,
 //! in 2D and 3D: exactly the particles on the outside of the fluid take P = 0.
 
 use crate::common::Lattice;

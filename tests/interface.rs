@@ -1,4 +1,4 @@
-//! Interfaces between fluids of different rest density (src/interface.rs): the distance each
+//! Interfaces between fluids of different rest density (src/sph/interface.rs): the distance each
 //! particle reads off the other fluid's share of its kernel, and the pair density between two.
 
 use crate::common::Lattice;

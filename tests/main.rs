@@ -16,6 +16,7 @@ mod free_surface;
 mod hydrostatic;
 mod interface;
 mod kernel;
+mod layering;
 mod linsolve;
 mod neighbours;
 mod operators;

@@ -4,8 +4,8 @@
 //! face it touches (`no_penetration`), and at the end of a step the hard contact that puts back
 //! a particle that crossed one (`contact`).
 
+use crate::math::aabb::Aabb;
 use crate::math::vector::{dot, norm, unit};
-use crate::scene::{Aabb, Scene};
 
 /// The container and the obstacles of a scene.
 #[derive(Clone, Debug)]
@@ -29,11 +29,12 @@ pub enum Contact {
 }
 
 impl Faces {
-    pub fn new(scene: &Scene) -> Self {
+    /// The faces of `container` (none across the axes that are `periodic`) and of `obstacles`.
+    pub fn new(container: &Aabb, periodic: &[bool], obstacles: &[Aabb]) -> Self {
         Self {
-            container: scene.container.clone(),
-            periodic: scene.periodic.clone(),
-            obstacles: scene.obstacles.clone(),
+            container: container.clone(),
+            periodic: periodic.to_vec(),
+            obstacles: obstacles.to_vec(),
         }
     }
 

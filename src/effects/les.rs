@@ -51,7 +51,7 @@ pub fn eddy_viscosity<const D: usize>(
 }
 
 /// The acceleration of fluid particle i by the turbulent part of the wall shear stress, with
-/// `face` the nearest wall's (`wall::nearest_face`): zero unless a wall particle lies within
+/// `face` the nearest wall's (`ghosts::nearest_face`): zero unless a wall particle lies within
 /// 1.5 dx (the particle touches the wall) and the particle sits in the log layer.
 pub fn wall_shear<const D: usize>(
     p: &Particles<D>,

@@ -32,7 +32,7 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
             });
         }
     });
-    let faces = Faces::new(scene);
+    let faces = Faces::new(&scene.container, &scene.periodic, &scene.obstacles);
     let wall_density = scene.fluids[0].density;
     let wall = |x: [f64; D]| NewParticle {
         pos: x,

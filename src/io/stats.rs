@@ -1,10 +1,24 @@
 //! `stats.csv`: one row per time step.
 
 use super::OutputError;
-use crate::simulation::StepStats;
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
+
+/// What one step measured: a row of `stats.csv` (without the wall time).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepStats {
+    pub step: u64,
+    pub time: f64,
+    pub dt: f64,
+    pub ppe_iterations: usize,
+    pub ppe_residual: f64,
+    pub max_speed: f64,
+    pub kinetic_energy: f64,
+    pub density_error: f64,
+    pub penetrations: usize,
+    pub disorder: f64,
+}
 
 pub const FILE_NAME: &str = "stats.csv";
 

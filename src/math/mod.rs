@@ -2,6 +2,7 @@
 //! vectors, SIMD lanes, thread-count-independent parallel loops and sums, the kernel of Eq. (19),
 //! the walk over lattice points, and the sizes of arrays.
 
+pub mod aabb;
 pub mod kernel;
 pub mod lanes;
 pub mod lattice;

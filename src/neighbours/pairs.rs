@@ -1,4 +1,4 @@
-//! The pair loop every operator is built on. The particles are sorted by kind and cell (`grid`),
+//! The pair loop every operator is built on. The particles are sorted by kind and cell (`cell_list`),
 //! so the neighbours of particle i lie in a few contiguous index ranges, one per row of cells
 //! within reach and kind (operators that need one kind only visit its ranges); the loop walks each range
 //! `LANES` particles at a time in SIMD lanes (`lanes::F64s`): positions are loaded contiguously,

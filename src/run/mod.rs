@@ -9,11 +9,12 @@ use crate::io::checkpoint::{Checkpoint, CheckpointError, RunState};
 use crate::io::checkpoint_folder;
 use crate::io::frames::{FrameInfo, FrameWriter};
 use crate::io::stats::StatsWriter;
+use crate::io::stats::StepStats;
 use crate::io::{prepare_output_dir, xdmf, OutputError};
 use crate::math::reduce::in_pool;
 use crate::run::progress::Progress;
 use crate::scene::Scene;
-use crate::simulation::{NoFluid, NumericalFailure, Simulation, StepStats};
+use crate::simulation::{NoFluid, NumericalFailure, Simulation};
 use crate::step::timings::Timings;
 use resume::{ResumeError, ResumeOptions};
 use std::path::{Path, PathBuf};
@@ -176,6 +177,8 @@ pub(crate) struct Output {
 
 /// A run in progress: the simulation and everything the run carries from step to step.
 struct Driver<'a, const D: usize> {
+    /// The end time as the user wrote it (`--until` or `end_time`), for the progress line.
+    requested_end: f64,
     scene: &'a Scene,
     sim: Simulation<D>,
     end: f64,
@@ -195,6 +198,9 @@ struct Driver<'a, const D: usize> {
     quiet: bool,
     stop: StopSignal,
 }
+
+/// Steps beyond which `isph run` warns at start that the run is very long.
+const MANY_STEPS: f64 = 1.0e7;
 
 /// `time`, or the multiple k × `interval` (k ≥ 1) within `FRAME_TIME_ROUNDING` intervals of it, as the
 /// frames' schedule computes it: a run ends on the frame it lands on anyway. So a run stopped
@@ -226,6 +232,7 @@ impl<'a, const D: usize> Driver<'a, D> {
         let now = Instant::now();
         let mut driver = Self {
             scene,
+            requested_end: until.unwrap_or(scene.end_time),
             end: on_frame(until.unwrap_or(scene.end_time), scene.output_interval),
             output,
             next_output: state.map_or(0, |s| s.next_output),
@@ -341,8 +348,28 @@ impl<'a, const D: usize> Driver<'a, D> {
         Ok(saved)
     }
 
+    /// Warns, on stderr, when the first time step puts the end more than `MANY_STEPS` steps
+    /// away, naming the condition that sets Δt: a run that would take that long is more likely
+    /// a mistyped viscosity or spacing than a wish.
+    fn warn_of_a_long_run(&self) {
+        // A collapsing step is the first step's to report.
+        let Ok((dt, limit)) = self.sim.time_step_limit() else {
+            return;
+        };
+        let steps = (self.end - self.sim.time) / dt;
+        if steps > MANY_STEPS {
+            eprintln!(
+                "warning: the first time step is {dt:.3e} s, set by {}: reaching t = {:?} s takes about {steps:.1e} steps",
+                limit.describe(),
+                self.requested_end
+            );
+        }
+    }
+
     fn drive(mut self) -> Result<RunSummary, RunError> {
-        let mut progress = Progress::new(self.sim.time, self.sim.step, self.end, self.quiet);
+        self.warn_of_a_long_run();
+        let mut progress =
+            Progress::new(self.sim.time, self.sim.step, self.requested_end, self.quiet);
         let (mut steps, mut ppe_total, mut last) = (0u64, 0u64, None);
         while self.sim.time < self.end {
             let (target, _) = self.next_frame();

@@ -1,6 +1,6 @@
 //! Progress of a run: an indicatif bar on a terminal, plain periodic lines otherwise.
 
-use crate::simulation::StepStats;
+use crate::io::stats::StepStats;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
@@ -102,7 +102,7 @@ impl Progress {
 
 fn message(s: &StepStats, end: f64, steps_per_second: f64) -> String {
     format!(
-        "t = {:.4}/{end} s | step {} | {:.1} steps/s | dt {:.2e} s | PPE {} it",
+        "t = {:.4}/{end:?} s | step {} | {:.1} steps/s | dt {:.2e} s | PPE {} it",
         s.time, s.step, steps_per_second, s.dt, s.ppe_iterations
     )
 }

@@ -5,6 +5,7 @@ mod effects;
 
 pub use effects::{Effects, LesSettings, ShiftingSettings};
 
+pub use crate::math::aabb::Aabb;
 use crate::math::kernel::SUPPORT_IN_H;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -164,7 +165,7 @@ pub struct WallSettings {
 #[serde(rename_all = "snake_case")]
 pub enum GhostPressure {
     /// P_b = P_i + ρ0 g·N_b (r_b − r_i): the Neumann condition of the projection,
-    /// ∂P/∂n = ρ0 g·n on a wall at rest (`wall`).
+    /// ∂P/∂n = ρ0 g·n on a wall at rest (`boundary::ghosts`).
     #[default]
     Hydrostatic,
     /// P_b = P_i: ∂P/∂n = 0, the walls mirror the fluid's pressure and hold no weight of
@@ -233,32 +234,6 @@ impl Default for CheckpointSettings {
             wall_interval: 1800.0,
             keep: 2,
         }
-    }
-}
-
-/// An axis-aligned box [min, max].
-#[derive(Debug, Clone, PartialEq)]
-pub struct Aabb {
-    pub min: Vec<f64>,
-    pub max: Vec<f64>,
-}
-
-impl Aabb {
-    /// True when x lies strictly inside the box.
-    pub fn contains(&self, x: &[f64]) -> bool {
-        self.contains_within(x, 0.0)
-    }
-
-    /// True when x lies strictly inside the box grown by `margin` on every side.
-    pub fn contains_within(&self, x: &[f64], margin: f64) -> bool {
-        x.iter()
-            .zip(&self.min)
-            .zip(&self.max)
-            .all(|((x, lo), hi)| *x > lo - margin && *x < hi + margin)
-    }
-
-    fn within(&self, outer: &Aabb) -> bool {
-        (0..self.min.len()).all(|d| self.min[d] >= outer.min[d] && self.max[d] <= outer.max[d])
     }
 }
 
@@ -406,7 +381,7 @@ impl Validator<'_> {
         self.check(
             value.is_finite() && value > 0.0,
             key,
-            format!("= {value} must be a positive number [{unit}]"),
+            format!("= {value:?} must be a positive number [{unit}]"),
         )
     }
 
@@ -441,7 +416,7 @@ impl Validator<'_> {
                 b.max[d] - b.min[d] >= spacing * (1.0 - 1e-9),
                 &format!("{key}.max"),
                 format!(
-                    "must exceed `{key}.min` by at least one particle spacing ({spacing} m) in every axis; axis {d} has {} .. {}",
+                    "must exceed `{key}.min` by at least one particle spacing ({spacing:?} m) in every axis; axis {d} has {:?} .. {:?}",
                     b.min[d], b.max[d]
                 ),
             )?;
@@ -490,7 +465,7 @@ impl Validator<'_> {
             frames <= MAX_FRAMES,
             "simulation.output_interval",
             format!(
-                "= {} makes {frames:.3e} frames to end_time = {} s; at most {MAX_FRAMES} (each frame holds every particle)",
+                "= {:?} makes {frames:.3e} frames to end_time = {:?} s; at most {MAX_FRAMES} (each frame holds every particle)",
                 s.output_interval, s.end_time
             ),
         )?;
@@ -507,7 +482,7 @@ impl Validator<'_> {
             self.check(
                 fl.viscosity.is_finite() && fl.viscosity >= 0.0,
                 &format!("{key}.viscosity"),
-                format!("= {} must be a non-negative number [m^2/s]", fl.viscosity),
+                format!("= {:?} must be a non-negative number [m^2/s]", fl.viscosity),
             )?;
             self.check(
                 f.fluid[..k].iter().all(|o| o.name != fl.name),
@@ -573,7 +548,7 @@ impl Validator<'_> {
         self.check(
             sv.tolerance > 0.0 && sv.tolerance < 1.0,
             "solver.tolerance",
-            format!("= {} must lie in (0, 1)", sv.tolerance),
+            format!("= {:?} must lie in (0, 1)", sv.tolerance),
         )?;
         self.check(
             sv.max_iterations >= 1,
@@ -584,19 +559,19 @@ impl Validator<'_> {
             (0.0..=1.0).contains(&sv.alpha),
             "solver.alpha",
             format!(
-                "= {} must lie in [0, 1] (0: divergence-free only, 1: density-invariant only)",
+                "= {:?} must lie in [0, 1] (0: divergence-free only, 1: density-invariant only)",
                 sv.alpha
             ),
         )?;
         self.check(
             sv.cfl > 0.0 && sv.cfl <= 1.0,
             "solver.cfl",
-            format!("= {} must lie in (0, 1]", sv.cfl),
+            format!("= {:?} must lie in (0, 1]", sv.cfl),
         )?;
         self.check(
             (1.0..=2.0).contains(&sv.h_over_dx),
             "solver.h_over_dx",
-            format!("= {} must lie in [1, 2]", sv.h_over_dx),
+            format!("= {:?} must lie in [1, 2]", sv.h_over_dx),
         )?;
 
         let initial_velocity = f
@@ -659,7 +634,7 @@ impl Validator<'_> {
         let particles = scene.particle_bound();
         let key = "simulation.spacing";
         let what = format!(
-            "= {} puts up to {particles:.3e} particles in the container and its walls",
+            "= {:?} puts up to {particles:.3e} particles in the container and its walls",
             scene.spacing
         );
         self.check(
@@ -715,12 +690,12 @@ impl Validator<'_> {
             self.check(
                 (spacings - spacings.round()).abs() < 1e-6 * spacings,
                 key,
-                format!("axis {d} is periodic, so its length {length} m must be a whole number of spacings ({spacing} m); it is {spacings:.4} spacings"),
+                format!("axis {d} is periodic, so its length {length:?} m must be a whole number of spacings ({spacing:?} m); it is {spacings:.4} spacings"),
             )?;
             self.check(
                 length >= 3.0 * support,
                 key,
-                format!("axis {d} is periodic, so its length {length} m must be at least three kernel supports (3 × 3h = {:.4} m)", 3.0 * support),
+                format!("axis {d} is periodic, so its length {length:?} m must be at least three kernel supports (3 × 3h = {:.4} m)", 3.0 * support),
             )?;
         }
         Ok(flags.to_vec())
@@ -754,7 +729,7 @@ impl Validator<'_> {
         self.check(
             v.amplitude.is_finite(),
             "initial_velocity.amplitude",
-            format!("= {} must be a finite number [m/s]", v.amplitude),
+            format!("= {:?} must be a finite number [m/s]", v.amplitude),
         )?;
         Ok(InitialVelocity::TaylorGreen {
             amplitude: v.amplitude,
@@ -808,7 +783,7 @@ impl Validator<'_> {
             settings.coefficient.is_finite() && settings.coefficient > 0.0,
             "effects.shifting.coefficient",
             format!(
-                "= {} must be a positive number (A of D = A h U Δt)",
+                "= {:?} must be a positive number (A of D = A h U Δt)",
                 settings.coefficient
             ),
         )?;
@@ -816,7 +791,7 @@ impl Validator<'_> {
             settings.max_shift > 0.0 && settings.max_shift <= 1.0,
             "effects.shifting.max_shift",
             format!(
-                "= {} must lie in (0, 1] [particle spacings]",
+                "= {:?} must lie in (0, 1] [particle spacings]",
                 settings.max_shift
             ),
         )?;
@@ -824,7 +799,7 @@ impl Validator<'_> {
             settings.clustering_weight.is_finite() && settings.clustering_weight >= 0.0,
             "effects.shifting.clustering_weight",
             format!(
-                "= {} must be a non-negative number",
+                "= {:?} must be a non-negative number",
                 settings.clustering_weight
             ),
         )?;
@@ -848,7 +823,7 @@ impl Validator<'_> {
             settings.cs > 0.0 && settings.cs <= 1.0,
             "effects.les.cs",
             format!(
-                "= {} must lie in (0, 1] (to turn LES off, set `effects.les.enabled = false`)",
+                "= {:?} must lie in (0, 1] (to turn LES off, set `effects.les.enabled = false`)",
                 settings.cs
             ),
         )?;

@@ -1,5 +1,5 @@
 //! The pressure Poisson equation of Eq. (6), assembled matrix-free. The unknowns are the fluid
-//! pressures; wall particles are ghosts of them (see `wall`) and hold no unknown.
+//! pressures; wall particles are ghosts of them (see `boundary::ghosts`) and hold no unknown.
 //!
 //! * interior rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt², with the Laplacian of
 //!   Eq. (27) made first-order consistent where the free surface truncates the kernel. The wall
@@ -11,7 +11,7 @@
 //! * splash rows (particles too isolated for a gradient): P_i = 0.
 //!
 //! The walls have no row: their pressures for output are computed after the solve from their
-//! fluid neighbours (`wall::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
+//! fluid neighbours (`ghosts::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
 //! first in the sorted order).
 
 use crate::boundary::ghosts::{behind_walls, ghost_pressure_difference, ghost_velocity};
@@ -287,7 +287,7 @@ fn divergence_source<const D: usize>(
     let rho_i = p.density[i];
     // Walls take the fluid's own u*_i less its normal velocity of the last step: the body force
     // is carried by the wall ghosts' Neumann condition, the wall's kinematic condition by the
-    // divergence (see `wall::ghost_velocity`).
+    // divergence (see `ghosts::ghost_velocity`).
     let u_star_i: [f64; D] = std::array::from_fn(|d| u_star[d][i]);
     let u_i = p.velocity(i);
     let velocity = |l: &Lanes<D>| -> [F64s; D] {
@@ -331,7 +331,7 @@ fn volume_mass<const D: usize>(
 /// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with c_i = 2 Σ_j
 /// (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support; every neighbour counted as one
 /// of i's own fluid, m_j = ρ0_i V_j, where the fluids differ). A wall ghost continues only the
-/// normal part of the field, so a wall neighbour contributes N_b r_ij (see `wall`): beside a plane
+/// normal part of the field, so a wall neighbour contributes N_b r_ij (see `boundary::ghosts`): beside a plane
 /// wall the wall supplies what the missing fluid would, but in a corner or where the surface meets
 /// a wall the support is truncated for the tangential part too. Subtracting that term, with ∇P_i
 /// the corrected gradient L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij − V_j

@@ -51,8 +51,8 @@ pub fn volume_gradient_factor<const D: usize>(
 /// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, ν_t the eddy viscosity
 /// of the Smagorinsky model (Eq. 3–4) where the scene runs LES (`eddy`; None: ν_t = 0). Wall
 /// particles take the fluid's laminar viscosity (the turbulent stress at a wall is the law of
-/// the wall's, `turbulence::wall_shear`) and the no-slip velocity of Morris, Fox & Zhu (1997),
-/// with `face` the nearest wall's in the kernel support (`wall::nearest_face`):
+/// the wall's, `les::wall_shear`) and the no-slip velocity of Morris, Fox & Zhu (1997),
+/// with `face` the nearest wall's in the kernel support (`ghosts::nearest_face`):
 /// u_b = −(d_b/d_i) u_i with d the distances to the wall face, which puts u = 0 on the face
 /// itself, so u_i − u_b = β u_i with β = 1 + d_b/d_i = n_b·r_ib/d_i, capped at
 /// `MORRIS_BETA_MAX` for the wall particles deep behind the face. (Walls simply at rest, β = 1, put
@@ -99,7 +99,7 @@ pub fn viscous_acceleration<const D: usize>(
 }
 
 /// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right
-/// at the face (d_i → 0); here d_i ≥ dx/4 (`wall::Face::distance`) bounds β anyway, and a cap of
+/// at the face (d_i → 0); here d_i ≥ dx/4 (`ghosts::Face::distance`) bounds β anyway, and a cap of
 /// 1.5 leaves the Poiseuille channel 4.2% too fast (4: 0.48%, no cap: 0.47%).
 const MORRIS_BETA_MAX: f64 = 4.0;
 
@@ -136,7 +136,7 @@ pub fn velocity_gradient<const D: usize>(
 
 /// The velocities of the neighbours in lanes `l` in a velocity gradient at fluid particle i of
 /// velocity `u_i`: their own for fluid, the free-slip ghost of u_i for walls
-/// (`wall::ghost_velocity`).
+/// (`ghosts::ghost_velocity`).
 #[inline(always)]
 pub fn fluid_velocity<const D: usize>(p: &Particles<D>, u_i: [f64; D], l: &Lanes<D>) -> [F64s; D] {
     match l.kind {
@@ -169,7 +169,7 @@ pub fn min_correction_determinant<const D: usize>(h_over_dx: f64) -> f64 {
 /// det M'_i at the top of the water in the corner of the walls, on a lattice of unit spacing:
 /// the particle at the origin, fluid where no index is positive, the walls where one of the
 /// first D − 1 indices is (at every height; each counts the offset along the axes it lies
-/// behind, `wall::behind_walls`), air above the water.
+/// behind, `ghosts::behind_walls`), air above the water.
 fn wall_corner_determinant<const D: usize>(h_over_dx: f64) -> f64 {
     let kernel = Quintic::<D>::new(h_over_dx);
     let reach = kernel.support().ceil() as i64;
@@ -206,7 +206,7 @@ pub struct Moments<const D: usize> {
     pub m: [[f64; D]; D],
     /// M_i with each wall neighbour's r_bi replaced by its part across the walls, N_b r_bi:
     /// the moment of a pressure field whose wall ghosts carry only the normal gradient (see
-    /// `wall`).
+    /// `boundary::ghosts`).
     pub m_neumann: [[f64; D]; D],
     /// ∇C_i = Σ_j V_j ∇W_ij, the concentration gradient.
     pub grad_c: [f64; D],

@@ -8,17 +8,12 @@
 //! operator's apply on the state reached (see [`PpeSetup`]) and prints a [`Measurement`] as TOML
 //! on stdout; the parent collects the points, prints a table and writes the CSV.
 
-use crate::math::kernel::Quintic;
-use crate::math::reduce::{fill, in_pool};
-use crate::neighbours::cell_list::CellList;
-use crate::neighbours::Neighbours;
-use crate::particles::{Kind, Particles};
+use crate::math::reduce::in_pool;
+use crate::particles::Kind;
 use crate::scene::{Scene, SceneError};
 use crate::simulation::{NoFluid, NumericalFailure, Simulation};
 use crate::solver::krylov::LinearOperator;
-use crate::solver::ppe::{self, PressureOperator, Role};
-use crate::sph::Corrections;
-use crate::step::timings::Stage;
+use crate::solver::ppe::{PressureOperator, Role};
 use crate::tools::child::{self, peak_resident_bytes, ChildError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -152,8 +147,9 @@ pub struct Measurement {
     pub time_end: f64,
     /// Wall time of each timed step, `advance_towards` as a whole [s].
     pub step_seconds: Vec<f64>,
-    /// Mean time of a timed step in each stage of `Simulation::timings`, in `Stage::ALL`
-    /// order [s].
+    /// The stages of the step, in order (`Step::stages`).
+    pub stages: Vec<String>,
+    /// Mean time of a timed step in each of `stages` [s].
     pub stage_seconds: Vec<f64>,
     pub ppe_iterations: Vec<usize>,
     /// `density_error` of the last timed step.
@@ -188,16 +184,16 @@ fn measure_in_pool(requested: usize, schedule: Schedule) -> Result<Measurement, 
         ppe_iterations.push(stats.ppe_iterations);
         density_error = stats.density_error;
     }
-    let stage_seconds = Stage::ALL
-        .iter()
-        .map(|&s| (sim.timings.get(s) - before.get(s)).as_secs_f64() / schedule.steps as f64)
+    let stages: Vec<String> = sim.timings.names().map(String::from).collect();
+    let stage_seconds = sim
+        .timings
+        .names()
+        .map(|s| (sim.timings.get(s) - before.get(s)).as_secs_f64() / schedule.steps as f64)
         .collect();
     // Read before the apply probe below allocates its own arrays.
     let peak_rss_bytes = peak_resident_bytes()?;
-    let gravity = std::array::from_fn(|d| scene.gravity[d]);
     let (fluid_particles, particles) = (sim.particles.fluid_count(), sim.particles.len());
-    let kernel = sim.kernel();
-    let (apply_pairs, apply_seconds) = time_ppe_apply(&mut sim.particles, kernel, gravity);
+    let (apply_pairs, apply_seconds) = time_ppe_apply(&mut sim)?;
     Ok(Measurement {
         requested,
         threads: rayon::current_num_threads(),
@@ -208,6 +204,7 @@ fn measure_in_pool(requested: usize, schedule: Schedule) -> Result<Measurement, 
         time_start,
         time_end: sim.time,
         step_seconds,
+        stages,
         stage_seconds,
         ppe_iterations,
         density_error,
@@ -223,117 +220,40 @@ impl Measurement {
     }
 }
 
-/// Times the PPE operator's apply on the particles' state: (pairs per apply, seconds of each
-/// timed apply). Re-sorts the particles.
+/// Times the PPE operator's apply on the particles' state, the operator built by the step's
+/// own stages (`Simulation::probe_pressure_operator`): (pairs per apply, seconds of each timed
+/// apply). Re-sorts the particles.
 fn time_ppe_apply<const D: usize>(
-    p: &mut Particles<D>,
-    kernel: Quintic<D>,
-    gravity: [f64; D],
-) -> (usize, Vec<f64>) {
-    let setup = PpeSetup::new(p, kernel);
-    let nb = setup.neighbours(p, kernel);
-    let op = setup.operator(&nb, p, gravity);
-    let x = p.pressure[..op.len()].to_vec();
-    let mut y = vec![0.0; op.len()];
-    op.apply(&x, &mut y);
-    let seconds = (0..APPLY_REPEATS)
-        .map(|_| {
-            let clock = Instant::now();
-            op.apply(&x, &mut y);
-            clock.elapsed().as_secs_f64()
-        })
-        .collect();
-    (setup.pairs(&nb), seconds)
-}
-
-/// The PPE operator of the step (`ppe::PressureOperator`), rebuilt from a particle state
-/// through the public API, to time its apply on its own.
-///
-/// The roles come from `Particles::free_surface`, the step's record of them (`Role::code`).
-/// Every interior row carries the consistency correction, as
-/// in the step, with the uncorrected c_i (the kernel correction's matrices are not rebuilt):
-/// each pair costs the arithmetic it costs in the step.
-pub struct PpeSetup<const D: usize> {
-    pub grid: CellList<D>,
-    pub roles: Vec<Role>,
-    pub row_vectors: [Vec<f64>; D],
-    pub fluid_volume: Vec<f64>,
-}
-
-impl<const D: usize> PpeSetup<D> {
-    /// Sorts `p` by cell on a grid around the particles and derives the operator's arrays.
-    pub fn new(p: &mut Particles<D>, kernel: Quintic<D>) -> Self {
-        // A support of margin: a particle on the box's face lies in an interior cell.
-        let support = kernel.support();
-        let lo =
-            std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MAX, f64::min) - support);
-        let hi =
-            std::array::from_fn(|d| p.pos[d].iter().copied().fold(f64::MIN, f64::max) + support);
-        let mut grid = CellList::new(lo, hi, support, [false; D]);
-        let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
-        grid.sort(&p.pos, &p.kind, &mut cells, &mut order)
-            .expect("the grid spans the particles' bounding box");
-        p.permute(&order, &mut scratch);
-        let nf = grid.range_of(Kind::Fluid).end;
-        let mut roles = vec![Role::Interior; nf];
-        fill(&mut roles, |i| Role::from_code(p.free_surface[i]));
-        let mut row_vectors = std::array::from_fn(|_| vec![0.0; nf]);
-        let nb = Neighbours::new(&grid, &p.pos, kernel);
-        // The dam break holds one fluid: no interfaces.
-        ppe::row_vectors(
-            &nb,
-            p,
-            None,
-            &roles,
-            Corrections::new(false, &[]),
-            &mut row_vectors,
-        );
-        let mut fluid_volume = Vec::new();
-        ppe::fluid_volumes(p, nf, &mut fluid_volume);
-        Self {
-            grid,
-            roles,
-            row_vectors,
-            fluid_volume,
-        }
-    }
-
-    pub fn neighbours<'a>(&'a self, p: &'a Particles<D>, kernel: Quintic<D>) -> Neighbours<'a, D> {
-        Neighbours::new(&self.grid, &p.pos, kernel)
-    }
-
-    pub fn operator<'a>(
-        &'a self,
-        nb: &'a Neighbours<'a, D>,
-        p: &'a Particles<D>,
-        gravity: [f64; D],
-    ) -> PressureOperator<'a, D> {
-        PressureOperator {
-            nb,
-            p,
-            roles: &self.roles,
-            row_vectors: &self.row_vectors,
-            fluid_volume: &self.fluid_volume,
-            gravity,
-            ghost_gravity: gravity,
-            interfaces: None,
-        }
-    }
-
-    /// Fluid neighbour pairs of the interior rows, the only rows that visit their neighbours
-    /// (the others are identity rows) and the only pairs they visit (the walls' are known
-    /// numbers, in the right-hand side): the pair interactions of one apply.
-    pub fn pairs(&self, nb: &Neighbours<D>) -> usize {
-        (0..self.roles.len())
-            .into_par_iter()
-            .filter(|&i| self.roles[i] == Role::Interior)
-            .map(|i| {
-                let mut n = 0;
-                nb.for_each_of(i, &[Kind::Fluid], |_, _, _| n += 1);
-                n
+    sim: &mut Simulation<D>,
+) -> Result<(usize, Vec<f64>), NumericalFailure> {
+    sim.probe_pressure_operator(|op| {
+        let x = op.p.pressure[..op.len()].to_vec();
+        let mut y = vec![0.0; op.len()];
+        op.apply(&x, &mut y);
+        let seconds = (0..APPLY_REPEATS)
+            .map(|_| {
+                let clock = Instant::now();
+                op.apply(&x, &mut y);
+                clock.elapsed().as_secs_f64()
             })
-            .sum()
-    }
+            .collect();
+        (apply_pairs(op), seconds)
+    })
+}
+
+/// Fluid neighbour pairs of the interior rows of `op`, the only rows that visit their
+/// neighbours (the others are identity rows) and the only pairs they visit (the walls' are
+/// known numbers, in the right-hand side): the pair interactions of one apply.
+pub fn apply_pairs<const D: usize>(op: &PressureOperator<D>) -> usize {
+    (0..op.roles.len())
+        .into_par_iter()
+        .filter(|&i| op.roles[i] == Role::Interior)
+        .map(|i| {
+            let mut n = 0;
+            op.nb.for_each_of(i, &[Kind::Fluid], |_, _, _| n += 1);
+            n
+        })
+        .sum()
 }
 
 /// What `isph bench` runs.
@@ -455,9 +375,9 @@ impl Row {
                 self.us_per_fluid_particle_step().to_string(),
             ),
         ];
-        for (stage, seconds) in Stage::ALL.iter().zip(&m.stage_seconds) {
+        for (stage, seconds) in m.stages.iter().zip(&m.stage_seconds) {
             f.push((
-                format!("{}_s", stage.name().replace(' ', "_")),
+                format!("{}_s", stage.replace(' ', "_")),
                 seconds.to_string(),
             ));
         }
@@ -674,8 +594,8 @@ pub fn table(rows: &[Row], schedule: Schedule) -> String {
     }
     let _ = writeln!(t, "time per step by stage [ms], mean over the timed steps:");
     let mut header = format!("{:>9} {:>3}", "fluid", "thr");
-    for s in Stage::ALL {
-        let _ = write!(header, " {:>14}", s.name());
+    for s in rows.first().map_or(&[][..], |r| &r.m.stages[..]) {
+        let _ = write!(header, " {:>14}", s);
     }
     let _ = writeln!(t, "{header} {:>8}", "other");
     for r in rows {

@@ -1,0 +1,152 @@
+//! Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls as
+//! ghosts; particles touching a wall face keep no velocity into it (`Faces::no_penetration`).
+//! Leaves ∇Pⁿ⁺¹ in place of u*.
+
+use super::free_surface::Surface;
+use super::{Stage, StepSettings};
+use crate::boundary::faces::Faces;
+use crate::boundary::ghosts;
+use crate::math::lanes::F64s;
+use crate::math::memory::ArraySize;
+use crate::math::reduce::fill_vector_and_update;
+use crate::neighbours::Neighbours;
+use crate::particles::{components, Kind, Particles};
+use crate::solver::ppe::Role;
+use crate::sph::{self, interface, Correction};
+
+pub const NAME: &str = "corrector";
+
+pub struct Corrector<const D: usize> {
+    /// uⁿ⁺¹ of each fluid particle (copied into the particles).
+    velocity: [Vec<f64>; D],
+}
+
+impl<const D: usize> Default for Corrector<D> {
+    fn default() -> Self {
+        Self {
+            velocity: components(),
+        }
+    }
+}
+
+impl<const D: usize> Corrector<D> {
+    /// uⁿ⁺¹ of the fluid particles from `u_star`, which then holds ∇Pⁿ⁺¹.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        faces: &Faces,
+        surface: &Surface<D>,
+        interfaces: Option<interface::Field<D>>,
+        u_star: &mut [Vec<f64>; D],
+        dt: f64,
+    ) -> &[Vec<f64>; D] {
+        let n = surface.roles.len();
+        for a in &mut self.velocity {
+            a.resize(n, 0.0);
+        }
+        let corrections = surface.pressure_corrections;
+        let touch = touching_distance(set.spacing);
+        let (roles, full) = (surface.roles, surface.full_support);
+        let ghost = set.ghost_gravity();
+        let particles = p;
+        fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
+            let p = particles;
+            let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
+            let grad = pressure_gradient(nb, p, ghost, interfaces, corrections.of(i), p_ref, i);
+            let rho0 = p.rest_density[i];
+            let u = std::array::from_fn(|d| u_star[d] - dt * grad[d] / rho0);
+            (faces.no_penetration(p.position(i), u, touch), grad)
+        });
+        &self.velocity
+    }
+
+    /// The velocity array, free once copied into the particles: the shifting's scratch.
+    pub fn velocity_scratch(&mut self) -> &mut [Vec<f64>; D] {
+        &mut self.velocity
+    }
+}
+
+impl<const D: usize> Stage<D> for Corrector<D> {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn describe(&self, set: &StepSettings<D>) -> String {
+        format!(
+            "Eq. (7): u = u* − (Δt/ρ0)∇P, ∇P {} with the walls as ghosts; no velocity into a wall face within half a spacing of it",
+            if set.effects.kernel_correction { "corrected by L'_i (Eq. 20, 24–25)" } else { "of Eq. (20)" }
+        )
+    }
+
+    fn arrays(&self) -> Vec<ArraySize> {
+        vec![ArraySize::of_components("velocity", &self.velocity)]
+    }
+}
+
+/// Distance from a wall face within which a fluid particle touches it (the kinematic condition
+/// of `Faces::no_penetration`): half a spacing, the distance at which the fluid's first layer
+/// rests, and a hair more so that the resting layer is included (docs/stabilisation.md has
+/// the still tank and the violent impact at other distances).
+pub fn touching_distance(spacing: f64) -> f64 {
+    0.5001 * spacing
+}
+
+/// `to[d][..n] = from[d]` for each component, n the length of `from`.
+pub fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
+    for (f, t) in from.iter().zip(to) {
+        t[..f.len()].copy_from_slice(f);
+    }
+}
+
+/// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25), the differences
+/// taken from `p_ref` (`pressure_reference`), and the walls as ghosts of P_i (see `ghosts`)
+/// carrying `ghost_gravity`: a particle whose pressure exceeds p_ref is pushed off a wall it
+/// presses on, but not out through a free surface; across the interface of two fluids
+/// (`interfaces`, the distances to it) each difference is weighted by ρ0_i/ρ̄_ij
+/// (`interface::Side::across`).
+fn pressure_gradient<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    ghost_gravity: [f64; D],
+    interfaces: Option<interface::Field<D>>,
+    l: &Correction<D>,
+    p_ref: f64,
+    i: usize,
+) -> [f64; D] {
+    let (p_ref, side) = (F64s::splat(p_ref), interface::Side::of(p, interfaces, i));
+    // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
+    let own = F64s::splat(p.pressure[i]) - p_ref;
+    sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
+        Kind::Fluid => side.across(p, interfaces, lanes, lanes.load(&p.pressure) - p_ref),
+        Kind::Wall => own + ghosts::ghost_pressure_difference(p, ghost_gravity, i, lanes),
+    })
+}
+
+/// The pressure at fluid particle i that its pressure gradient takes the differences
+/// P_j − P_i from: P_i itself, but for an unknown of the PPE with the free surface in its
+/// kernel support (`role` Interior, not `full_support`) the value P̃_i of the linear function
+/// fitted to its fluid neighbours' pressures (`sph::fitted_value`; P_i where they fix none).
+/// Both are exact for a linear field. Where the surface truncates the support, the difference
+/// form carries the term −P_i L'_i Σ_j V_j ∇W_ij, which points out of the fluid: a particle
+/// whose pressure dips below its neighbours' is pushed towards the surface, and the projection
+/// feeds the velocity that lowered its pressure. On the still tank of `hydrostatic_2d` the
+/// step's velocity map, u ← u − (Δt/ρ0)∇P of the PPE of u, then amplifies a zig-zag of the row
+/// under the surface by 0.32% per step (its largest eigenvalue at rest, by power iteration),
+/// and the tank sloshes after 28 s; with P̃_i the largest eigenvalue is 1, the divergence-free
+/// fields' (docs/stabilisation.md).
+fn pressure_reference<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    role: Role,
+    full_support: bool,
+    i: usize,
+) -> f64 {
+    if role == Role::Interior && !full_support {
+        sph::fitted_value(nb, p, &p.pressure, i).unwrap_or(p.pressure[i])
+    } else {
+        p.pressure[i]
+    }
+}

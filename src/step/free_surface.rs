@@ -1,0 +1,170 @@
+//! How each kernel support is filled, from its moments (`sph::support_moments`): the free
+//! surface and the role of each fluid particle in the PPE (`ppe::role`), the particles with no
+//! free surface in reach, and the corrections the moments give at no extra pass: the pressure
+//! gradient's L'_i of Eq. (25) with the kernel correction, the surface normal with shifting.
+
+use super::{Stage, StepSettings};
+use crate::math::memory::ArraySize;
+use crate::neighbours::Neighbours;
+use crate::particles::Particles;
+use crate::scene::Effects;
+use crate::solver::ppe::{self, Role};
+use crate::sph::free_surface::Support;
+use crate::sph::{self, Correction, Corrections};
+use rayon::iter::Either;
+use rayon::prelude::*;
+
+pub const NAME: &str = "free surface";
+
+pub struct FreeSurface<const D: usize> {
+    roles: Vec<Role>,
+    /// The particle pinned to P = 0 where the fluid has no free surface (`ppe::pin_reference`;
+    /// None: the fluid has one, its pressure is absolute and cannot hold a tension).
+    reference: Option<usize>,
+    /// No free-surface particle in the kernel support.
+    full_support: Vec<bool>,
+    /// The correction L'_i of the pressure gradient, whose wall ghosts carry the normal part
+    /// of the gradient only (see `sph::Moments`) (with the kernel correction).
+    pressure_corrections: Option<Vec<Correction<D>>>,
+    /// The free surface's outward normal of each fluid particle, where shifting keeps to the
+    /// tangential direction (with shifting).
+    surface_normal: Option<Vec<[f64; D]>>,
+}
+
+/// What the stage found, for the stages after it.
+#[derive(Clone, Copy)]
+pub struct Surface<'a, const D: usize> {
+    pub roles: &'a [Role],
+    pub reference: Option<usize>,
+    pub full_support: &'a [bool],
+    /// L'_i (the identity without the kernel correction).
+    pub pressure_corrections: Corrections<'a, D>,
+    /// The outward normals (with shifting).
+    pub normals: Option<&'a [[f64; D]]>,
+}
+
+impl<const D: usize> FreeSurface<D> {
+    pub fn new(effects: &Effects) -> Self {
+        Self {
+            roles: Vec::new(),
+            reference: None,
+            full_support: Vec::new(),
+            pressure_corrections: effects.kernel_correction.then(Vec::new),
+            surface_normal: effects.shifting.map(|_| Vec::new()),
+        }
+    }
+
+    /// Classifies the `nf` fluid particles, inverting L'_i from the same moments (once per step
+    /// for every operator after it).
+    pub fn run(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, nf: usize) {
+        let n = nf;
+        self.roles.resize(n, Role::Interior);
+        let corrections = match &mut self.pressure_corrections {
+            Some(l) => {
+                l.resize(n, None);
+                Either::Left(l.par_iter_mut().map(Some))
+            }
+            None => Either::Right((0..n).into_par_iter().map(|_| None)),
+        };
+        let normals = match &mut self.surface_normal {
+            Some(normals) => {
+                normals.resize(n, [0.0; D]);
+                Either::Left(normals.par_iter_mut().map(Some))
+            }
+            None => Either::Right((0..n).into_par_iter().map(|_| None)),
+        };
+        self.roles
+            .par_iter_mut()
+            .zip(normals)
+            .zip(corrections)
+            .enumerate()
+            .for_each(|(i, ((role, normal), corrections))| {
+                let mo = sph::support_moments(nb, p, i);
+                let l_pressure =
+                    sph::gradient_correction(mo.m_neumann, set.min_correction_determinant);
+                let support = Support::new(&mo.m, mo.grad_c);
+                // Fluid that fills its container has no free surface: every row is interior
+                // (a disordered patch of a periodic flow can look like a surface to the
+                // detection).
+                *role = if set.confined {
+                    Role::Interior
+                } else {
+                    ppe::role(
+                        nb,
+                        p,
+                        &support,
+                        mo.fluid_neighbours,
+                        l_pressure.is_some(),
+                        set.spray_density,
+                        i,
+                    )
+                };
+                if let Some(normal) = normal {
+                    *normal = support.normal;
+                }
+                if let Some(lp) = corrections {
+                    *lp = l_pressure;
+                }
+            });
+        self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
+        ppe::full_support(nb, &self.roles, &mut self.full_support);
+    }
+
+    pub fn full_support(&self) -> &[bool] {
+        &self.full_support
+    }
+
+    /// Pins fluid particle `i` to P = 0, the role the free surface plays elsewhere (the
+    /// pressure solve's sealed regions).
+    pub fn pin(&mut self, i: usize) {
+        self.roles[i] = Role::Reference;
+    }
+
+    pub fn output(&self) -> Surface<'_, D> {
+        Surface {
+            roles: &self.roles,
+            reference: self.reference,
+            full_support: &self.full_support,
+            pressure_corrections: self.pressure_corrections(),
+            normals: self.surface_normal.as_deref(),
+        }
+    }
+
+    fn pressure_corrections(&self) -> Corrections<'_, D> {
+        match &self.pressure_corrections {
+            Some(l) => Corrections::new(true, l),
+            None => Corrections::new(false, &[]),
+        }
+    }
+}
+
+impl<const D: usize> Stage<D> for FreeSurface<D> {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn describe(&self, _: &StepSettings<D>) -> String {
+        let mut what = "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".to_string();
+        if self.pressure_corrections.is_some() {
+            what += "; L'_i of Eq. (25) for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only), inverted from the same moments";
+        }
+        if self.surface_normal.is_some() {
+            what += "; the surface normal, for the shifting";
+        }
+        what
+    }
+
+    fn arrays(&self) -> Vec<ArraySize> {
+        let mut arrays = vec![
+            ArraySize::of("PPE role", &self.roles),
+            ArraySize::of("full support", &self.full_support),
+        ];
+        if let Some(l) = &self.pressure_corrections {
+            arrays.push(ArraySize::of("L'", l));
+        }
+        if let Some(normals) = &self.surface_normal {
+            arrays.push(ArraySize::of("surface normal", normals));
+        }
+        arrays
+    }
+}

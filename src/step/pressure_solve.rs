@@ -1,0 +1,267 @@
+//! The pressure Poisson equation, Eq. (6), assembled matrix-free (`solver::ppe`) and solved by
+//! BiCGSTAB preconditioned by the aggregation multigrid, from the last pressure (warm start;
+//! the unknowns are the fluid pressures, walls hold none).
+
+use super::free_surface::{FreeSurface, Surface};
+use super::time_step::StepLength;
+use super::{Stage, StepSettings};
+use crate::math::memory::ArraySize;
+use crate::math::reduce::{self, fill};
+use crate::neighbours::Neighbours;
+use crate::particles::{components, Particles};
+use crate::scene::GhostPressure;
+use crate::solver::krylov::{BiCgStab, Preconditioner, SolveInfo, SolverError};
+use crate::solver::multigrid::Multigrid;
+use crate::solver::ppe::{self, PressureOperator, Role};
+use crate::sph::interface;
+use crate::sph::Corrections;
+use rayon::prelude::*;
+
+pub const NAME: &str = "pressure solve";
+
+pub struct PressureSolve<const D: usize> {
+    rows: Rows<D>,
+    rhs: Vec<f64>,
+    /// The solution (before the cavitation clip that the particles' pressure takes).
+    pressure: Vec<f64>,
+    bicgstab: BiCgStab,
+    multigrid: Multigrid<D>,
+}
+
+/// The per-row arrays of the operator.
+struct Rows<const D: usize> {
+    /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
+    row_vectors: [Vec<f64>; D],
+    /// V_j = m_j/ρ0_j of fluid particles (the unknowns of the PPE).
+    fluid_volume: Vec<f64>,
+}
+
+impl<const D: usize> Default for PressureSolve<D> {
+    fn default() -> Self {
+        Self {
+            rows: Rows {
+                row_vectors: components(),
+                fluid_volume: Vec::new(),
+            },
+            rhs: Vec::new(),
+            pressure: Vec::new(),
+            bicgstab: BiCgStab::default(),
+            multigrid: Multigrid::default(),
+        }
+    }
+}
+
+impl<const D: usize> PressureSolve<D> {
+    /// Solves for Pⁿ⁺¹ from u* (`u_star`) and the density error, with the roles of `surface`
+    /// (sealed regions are pinned there), the divergence corrected by `corrections`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        surface: &mut FreeSurface<D>,
+        corrections: Corrections<D>,
+        interfaces: Option<interface::Field<D>>,
+        u_star: &[Vec<f64>; D],
+        step: StepLength,
+    ) -> Result<SolveInfo, SolverError> {
+        let nf = surface.full_support().len();
+        let Self {
+            rows,
+            rhs,
+            pressure,
+            bicgstab,
+            multigrid,
+        } = self;
+        pressure.resize(nf, 0.0);
+        let particles = p;
+        with_operator(
+            rows,
+            multigrid,
+            nb,
+            particles,
+            set,
+            surface,
+            interfaces,
+            |op, mg, sealed, s| {
+                let reference = s.reference;
+                ppe::source(
+                    op,
+                    reference.is_some(),
+                    sealed,
+                    s.full_support,
+                    set.spacing,
+                    corrections,
+                    u_star,
+                    step.dt,
+                    set.alpha / step.limit,
+                    rhs,
+                );
+                let roles = op.roles;
+                // In a closed box the last pressure is shifted to the new reference's level.
+                let level = reference.map_or(0.0, |r| particles.pressure[r]);
+                fill(pressure, |i| match roles[i] {
+                    Role::Interior | Role::Surface => particles.pressure[i] - level,
+                    Role::Splash | Role::Reference => 0.0,
+                });
+                let info = bicgstab.solve(op, mg, rhs, pressure, set.solver)?;
+                if reference.is_some() {
+                    zero_mean_pressure(particles, pressure);
+                }
+                Ok(info)
+            },
+        )
+    }
+
+    /// The solution of the last `run` (before the cavitation clip the particles' pressure takes).
+    pub fn pressure(&self) -> &[f64] {
+        &self.pressure
+    }
+
+    /// Hands `probe` the operator `run` would solve with (for `isph bench`).
+    pub fn probe<R>(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        surface: &mut FreeSurface<D>,
+        interfaces: Option<interface::Field<D>>,
+        probe: impl FnOnce(&PressureOperator<D>) -> R,
+    ) -> Result<R, SolverError> {
+        let Self {
+            rows, multigrid, ..
+        } = self;
+        with_operator(
+            rows,
+            multigrid,
+            nb,
+            p,
+            set,
+            surface,
+            interfaces,
+            |op, _, _, _| Ok(probe(op)),
+        )
+    }
+}
+
+/// Builds the operator of the PPE rows of `surface`'s roles and sets the multigrid up on it,
+/// then calls `solve` with the operator, the multigrid, the sealed regions and the surface.
+///
+/// Water sealed off from the free surface (a compartment under a lid, a pocket against a wall)
+/// has no pressure level of its own: its highest particle is pinned to P = 0, the role the
+/// free surface plays elsewhere, and the hierarchy rebuilt (a pinned region is anchored, so
+/// the second pass finds none).
+#[allow(clippy::too_many_arguments)]
+fn with_operator<const D: usize, R>(
+    rows: &mut Rows<D>,
+    multigrid: &mut Multigrid<D>,
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    set: &StepSettings<D>,
+    surface: &mut FreeSurface<D>,
+    interfaces: Option<interface::Field<D>>,
+    solve: impl FnOnce(
+        &PressureOperator<D>,
+        &mut Multigrid<D>,
+        &[Vec<usize>],
+        &Surface<D>,
+    ) -> Result<R, SolverError>,
+) -> Result<R, SolverError> {
+    let n = surface.full_support().len();
+    for a in &mut rows.row_vectors {
+        a.resize(n, 0.0);
+    }
+    {
+        let s = surface.output();
+        ppe::row_vectors(
+            nb,
+            p,
+            interfaces,
+            s.roles,
+            s.pressure_corrections,
+            &mut rows.row_vectors,
+        );
+    }
+    ppe::fluid_volumes(p, n, &mut rows.fluid_volume);
+    let mut sealed = Vec::new();
+    let (op, s) = loop {
+        let s = surface.output();
+        let op = PressureOperator {
+            nb,
+            p,
+            roles: s.roles,
+            row_vectors: &rows.row_vectors,
+            fluid_volume: &rows.fluid_volume,
+            gravity: set.gravity,
+            ghost_gravity: set.ghost_gravity(),
+            interfaces,
+        };
+        multigrid.setup(&op)?;
+        let unanchored = multigrid.unanchored_regions();
+        if unanchored.is_empty() {
+            break (op, s);
+        }
+        for region in &unanchored {
+            let top = ppe::highest(p, set.gravity, region.iter().copied())
+                .expect("a region holds unknowns");
+            surface.pin(top);
+        }
+        sealed.extend(unanchored);
+    };
+    solve(&op, multigrid, &sealed, &s)
+}
+
+/// The pressure the fluid takes: with a free surface the pressure is absolute (zero at the
+/// surface) and the water cannot hold a tension, so negative pressures are cut to zero; in a
+/// closed box (`clip` false) only differences count and P is kept as solved.
+#[inline]
+pub fn cavitation(clip: bool, pressure: f64) -> f64 {
+    if clip {
+        pressure.max(0.0)
+    } else {
+        pressure
+    }
+}
+
+/// Shifts the fluid pressures of a closed box to a zero mean (walls hold no unknown): the
+/// PPE fixes them only up to a constant, and a pressure level that does not depend on which
+/// particle happened to be the reference keeps the frames comparable.
+fn zero_mean_pressure<const D: usize>(p: &Particles<D>, pressure: &mut [f64]) {
+    let [volume, integral] = reduce::sums(pressure.len(), |i| {
+        let v = p.mass[i] / p.rest_density[i];
+        [v, v * pressure[i]]
+    });
+    let mean = integral / volume;
+    pressure.par_iter_mut().for_each(|x| *x -= mean);
+}
+
+impl<const D: usize> Stage<D> for PressureSolve<D> {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn describe(&self, set: &StepSettings<D>) -> String {
+        format!(
+            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start",
+            if set.effects.kernel_correction { " (corrected by L_i)" } else { "" },
+            set.alpha,
+            match set.ghost_pressure {
+                GhostPressure::Hydrostatic => "Neumann ghosts of the fluid pressure, P_b = P_i + ρ0 g·N_b r_bi",
+                GhostPressure::Mirror => "mirror ghosts of the fluid pressure, P_b = P_i (∂P/∂n = 0)",
+            }
+        )
+    }
+
+    fn arrays(&self) -> Vec<ArraySize> {
+        let mut arrays = vec![
+            ArraySize::of_components("row vector", &self.rows.row_vectors),
+            ArraySize::of("fluid volume", &self.rows.fluid_volume),
+            ArraySize::of("right-hand side", &self.rhs),
+            ArraySize::of("pressure", &self.pressure),
+        ];
+        arrays.extend(self.bicgstab.arrays());
+        arrays.extend(self.multigrid.fine_arrays());
+        arrays
+    }
+}

@@ -1,0 +1,127 @@
+//! Particle shifting δr = −D ∇C (Eq. 10, `effects::shifting`) at rⁿ, then velocity and
+//! pressure carried to the shifted position by Eq. (9); the shift itself is the advection's.
+
+use super::corrector::touching_distance;
+use super::free_surface::Surface;
+use super::pressure_solve::cavitation;
+use super::{Stage, StepSettings};
+use crate::boundary::faces::Faces;
+use crate::effects::shifting as fickian;
+use crate::math::memory::ArraySize;
+use crate::math::reduce::{self, fill_vector};
+use crate::neighbours::{Lanes, Neighbours};
+use crate::particles::{components, Particles};
+use crate::scene::ShiftingSettings;
+use crate::solver::ppe::Role;
+use crate::sph::{self, Corrections};
+use rayon::prelude::*;
+
+pub const NAME: &str = "shifting";
+
+pub struct Shifting<const D: usize> {
+    settings: ShiftingSettings,
+    /// Shifting displacement δr of each fluid particle.
+    shift: [Vec<f64>; D],
+}
+
+impl<const D: usize> Shifting<D> {
+    pub fn new(settings: ShiftingSettings) -> Self {
+        Self {
+            settings,
+            shift: components(),
+        }
+    }
+
+    /// δr of the fluid particles, and into `velocity` their velocity at the shifted position
+    /// (Eq. 9) from the velocity gradient (corrected by `corrections`). Returns δr.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        faces: &Faces,
+        surface: &Surface<D>,
+        corrections: Corrections<D>,
+        velocity: &mut [Vec<f64>; D],
+        dt: f64,
+    ) -> &[Vec<f64>; D] {
+        let n = surface.roles.len();
+        for a in &mut self.shift {
+            a.resize(n, 0.0);
+        }
+        let max_speed = reduce::max(n, |i| p.speed(i));
+        let shifting = fickian::Shifting::new(nb, &self.settings, set.spacing, max_speed, dt);
+        let normals = surface
+            .normals
+            .expect("the free-surface stage keeps normals for shifting");
+        let (roles, full) = (surface.roles, surface.full_support);
+        let touch = touching_distance(set.spacing);
+        let particles = p;
+        fill_vector(&mut self.shift, |i| match roles[i] {
+            // Splashes are left in place: neither ∇C nor the Taylor correction means anything
+            // there.
+            Role::Interior | Role::Surface | Role::Reference => {
+                let dr = shifting.displacement(nb, particles, normals[i], full[i], i);
+                faces.no_penetration(particles.position(i), dr, touch)
+            }
+            Role::Splash => [0.0; D],
+        });
+        let shift = &self.shift;
+        fill_vector(velocity, |i| {
+            let p = particles;
+            // Where the free surface is in reach the velocity gradient is no longer that of a
+            // filled support, and shifting moves particles into the thinning, faster parts of a
+            // stretching flow: the Taylor step there feeds the flow energy
+            // (docs/stabilisation.md).
+            if !full[i] {
+                return p.velocity(i);
+            }
+            let u_i = p.velocity(i);
+            let u = |l: &Lanes<D>| sph::fluid_velocity(p, u_i, l);
+            let g = sph::velocity_gradient(nb, p, corrections.of(i), u_i, u, i);
+            let dr = vector(shift, i);
+            std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
+        });
+        &self.shift
+    }
+}
+
+/// The fluid pressures carried to the shifted positions by Eq. (9), P += ∇Pⁿ⁺¹·δr, with ∇Pⁿ⁺¹
+/// at rⁿ as the corrector left it (the walls' pressures for a frame do not enter it); clipped
+/// for cavitation as the solve's (`clip`).
+pub fn carry_pressure<const D: usize>(
+    pressure: &mut [f64],
+    grad_p: &[Vec<f64>; D],
+    shift: &[Vec<f64>; D],
+    clip: bool,
+) {
+    pressure.par_iter_mut().enumerate().for_each(|(i, p)| {
+        let (g, dr) = (vector(grad_p, i), vector(shift, i));
+        *p = cavitation(clip, *p + (0..D).map(|d| g[d] * dr[d]).sum::<f64>());
+    });
+}
+
+/// Component vector i of a SoA vector field.
+#[inline]
+fn vector<const D: usize>(a: &[Vec<f64>; D], i: usize) -> [f64; D] {
+    std::array::from_fn(|d| a[d][i])
+}
+
+impl<const D: usize> Stage<D> for Shifting<D> {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn describe(&self, _: &StepSettings<D>) -> String {
+        let s = self.settings;
+        format!(
+            "Fickian shifting δr = −D∇C (Eq. 10), D = {} h U Δt, anti-clustering weight R = {}, each component at most {} dx, tangential at the free surface; u and P Taylor-corrected to the new position (Eq. 9)",
+            s.coefficient, s.clustering_weight, s.max_shift
+        )
+    }
+
+    fn arrays(&self) -> Vec<ArraySize> {
+        vec![ArraySize::of_components("δr", &self.shift)]
+    }
+}

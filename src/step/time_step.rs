@@ -1,0 +1,94 @@
+//! The length of a step: the CFL, viscous and body-force limits, and the cut that lands a step
+//! on the next frame's time.
+
+use super::{StepError, StepSettings};
+use crate::math::reduce;
+use crate::particles::Particles;
+
+/// Viscous time-step limit Δt ≤ C_ν h²/ν.
+const VISCOUS_NUMBER: f64 = 0.125;
+/// Body-force time-step limit Δt ≤ C_g √(h/|g|).
+const BODY_FORCE_NUMBER: f64 = 0.25;
+/// A CFL time step below this fraction of the body-force step is a blow-up.
+const COLLAPSE_FRACTION: f64 = 1.0e-3;
+
+/// The length of a step and the limit it was cut from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepLength {
+    /// Δt of this step [s].
+    pub dt: f64,
+    /// Δt_max, the limit of the CFL, viscous and body-force conditions [s]: Δt is shorter
+    /// only where the step is cut to land on a frame time. The density-invariance term of the
+    /// PPE relaxes the density error over Δt_max, not Δt (`ppe::source`).
+    pub limit: f64,
+}
+
+/// Which condition sets Δt_max.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Limit {
+    /// Δt ≤ CFL h / max |u|.
+    Cfl,
+    /// Δt ≤ C_ν h²/ν, with ν the largest viscosity of the scene's fluids.
+    Viscous,
+    /// Δt ≤ C_g √(h/|g|).
+    BodyForce,
+}
+
+impl Limit {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Limit::Cfl => "the CFL condition (solver.cfl × h / the largest fluid speed)",
+            Limit::Viscous => "the viscous condition (0.125 h²/ν with the largest fluid viscosity)",
+            Limit::BodyForce => "the body-force condition (0.25 √(h/|g|))",
+        }
+    }
+}
+
+/// Largest stable Δt of particles `p` with smoothing length `h`: CFL, viscous and body-force
+/// limits, and the one that sets it. A CFL step far below the body-force step means the flow
+/// has blown up: that is reported, not integrated (without gravity there is no such
+/// reference, and only a non-finite velocity stops the run).
+pub fn limiting<const D: usize>(
+    p: &Particles<D>,
+    h: f64,
+    set: &StepSettings<D>,
+) -> Result<(f64, Limit), StepError> {
+    let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { p.speed(i) } else { 0.0 });
+    let g = set.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+    let (cfl, body_force) = (set.cfl * h / max_speed, BODY_FORCE_NUMBER * (h / g).sqrt());
+    let viscous = VISCOUS_NUMBER * h * h / set.max_viscosity;
+    let dt = cfl.min(body_force).min(viscous);
+    if body_force.is_finite() && cfl < COLLAPSE_FRACTION * body_force {
+        return Err(StepError::Collapse { dt, max_speed });
+    }
+    let limit = if dt == cfl {
+        Limit::Cfl
+    } else if dt == body_force {
+        Limit::BodyForce
+    } else {
+        Limit::Viscous
+    };
+    Ok((dt, limit))
+}
+
+/// `limiting`'s Δt_max alone.
+pub fn limit<const D: usize>(
+    p: &Particles<D>,
+    h: f64,
+    set: &StepSettings<D>,
+) -> Result<f64, StepError> {
+    limiting(p, h, set).map(|(dt, _)| dt)
+}
+
+/// The step of at most `limit` towards a target `remaining` ahead, and whether it lands on
+/// it: exactly when it is within reach (two steps to go are split evenly, so no step is tiny).
+pub fn length(limit: f64, remaining: f64) -> (StepLength, bool) {
+    let dt = if remaining <= limit {
+        remaining
+    } else if remaining < 2.0 * limit {
+        0.5 * remaining
+    } else {
+        limit
+    };
+    (StepLength { dt, limit }, dt == remaining)
+}
