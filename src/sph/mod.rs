@@ -4,7 +4,7 @@
 pub mod free_surface;
 pub mod interface;
 
-use crate::boundary::ghosts::{behind_walls, ghost_velocity, Face};
+use crate::boundary::ghosts::{self, behind_walls, ghost_velocity, Face};
 use crate::math::kernel::Quintic;
 use crate::math::lanes::{F64s, Sum};
 use crate::math::lattice::for_each_lattice_point;
@@ -51,13 +51,9 @@ pub fn volume_gradient_factor<const D: usize>(
 /// Viscous acceleration ∇·(ν∇u)_i of Eq. (26) with ν = ν_fluid + ν_t, ν_t the eddy viscosity
 /// of the Smagorinsky model (Eq. 3–4) where the scene runs LES (`eddy`; None: ν_t = 0). Wall
 /// particles take the fluid's laminar viscosity (the turbulent stress at a wall is the law of
-/// the wall's, `les::wall_shear`) and the no-slip velocity of Morris, Fox & Zhu (1997),
-/// with `face` the nearest wall's in the kernel support (`ghosts::nearest_face`):
-/// u_b = −(d_b/d_i) u_i with d the distances to the wall face, which puts u = 0 on the face
-/// itself, so u_i − u_b = β u_i with β = 1 + d_b/d_i = n_b·r_ib/d_i, capped at
-/// `MORRIS_BETA_MAX` for the wall particles deep behind the face. (Walls simply at rest, β = 1, put
-/// the no-slip line about half a spacing behind the face: a Poiseuille channel 20 particles wide
-/// then flows 12% too fast.)
+/// the wall's, `les::wall_shear`) and the no-slip velocity of Morris, Fox & Zhu (1997)
+/// (`ghosts::no_slip_difference`), with `face` the nearest wall's in the kernel support
+/// (`ghosts::nearest_face`).
 pub fn viscous_acceleration<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
@@ -73,12 +69,8 @@ pub fn viscous_acceleration<const D: usize>(
     nb.for_each_lanes(i, |l| {
         let (nu_i, nu_j, du): (F64s, F64s, [F64s; D]) = match l.kind {
             Kind::Wall => {
-                let n_r = (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s));
-                let beta = (n_r / d_i)
-                    .fast_max(F64s::ONE)
-                    .fast_min(F64s::splat(MORRIS_BETA_MAX));
                 let nu = F64s::splat(nu_laminar);
-                (nu, nu, u_i.map(|u| beta * F64s::splat(u)))
+                (nu, nu, ghosts::no_slip_difference(p, l, u_i, d_i))
             }
             Kind::Fluid => {
                 let nu_t = eddy.map_or(F64s::ZERO, |e| l.load(e));
@@ -97,11 +89,6 @@ pub fn viscous_acceleration<const D: usize>(
     });
     acc.map(|a| a.total())
 }
-
-/// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right
-/// at the face (d_i → 0); here d_i ≥ dx/4 (`ghosts::Face::distance`) bounds β anyway, and a cap of
-/// 1.5 leaves the Poiseuille channel 4.2% too fast (4: 0.48%, no cap: 0.47%).
-const MORRIS_BETA_MAX: f64 = 4.0;
 
 /// Corrected gradient of a velocity field, G[b][a] = ∂u_a/∂x_b = Σ_c L_bc Σ_j V_j (u_j − u_i)_a ∂_c W_ij
 /// (Eq. 20 with Eq. 24–25), with `u_i` the velocity of particle i and `u(l)` the velocities
