@@ -1,18 +1,19 @@
 //! isph: a stabilised incompressible SPH solver (Hassaballah, Aly & Abdelnaim 2020).
 //!
 //! A scene file becomes a [`Scene`]; [`fill`] puts its particles on the lattice, and they
-//! advance by the projection step of [`step`], which [`Simulation`] times and repeats; [`run()`]
-//! drives a whole run with its output and checkpoints, and [`resume()`] continues one.
+//! advance by the projection step of `step` (one file per stage), which [`Simulation`] repeats;
+//! [`run()`] drives a whole run with its output and checkpoints, and [`resume()`] continues one.
 //!
-//! The layers, lowest first (a module imports only from layers below it; `tests/layering.rs`
-//! holds this): [`math`] → [`scene`] → [`particles`] → [`neighbours`] → [`boundary`] → [`sph`]
-//! → [`solver`], [`effects`] → [`step`] → [`simulation`] → [`io`], [`run`] → [`tools`].
+//! The layers, lowest first (a module imports only from its own folder and the layers before
+//! it; `tests/layering.rs` holds this): [`math`], [`scene`], [`particles`], [`neighbours`],
+//! [`boundary`], [`sph`], [`solver`], `effects`, [`fill`], `step`, [`simulation`], [`io`],
+//! [`run`], [`tools`].
 
 // Axis and tensor loops index several arrays by the same d (or a, b), as the equations do.
 #![allow(clippy::needless_range_loop)]
 
 pub mod boundary;
-pub mod effects;
+pub(crate) mod effects;
 pub mod fill;
 pub mod io;
 pub mod math;
@@ -23,7 +24,7 @@ pub mod scene;
 pub mod simulation;
 pub mod solver;
 pub mod sph;
-pub mod step;
+pub(crate) mod step;
 pub mod tools;
 
 // The facade: what the command line (`main.rs`) and a program driving isph use.

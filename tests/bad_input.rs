@@ -218,7 +218,7 @@ fn an_existing_run_is_never_overwritten_by_accident() {
 }
 
 /// `isph plan x | head -1`, `isph run x | true`: a reader of stdout that has gone away is not
-/// an error (it was a panic: "failed printing to stdout: Broken pipe").
+/// an error, nor a panic ("failed printing to stdout: Broken pipe").
 #[test]
 fn a_closed_stdout_is_not_an_error() {
     let dir = TempDir::new("closed-stdout");
@@ -245,7 +245,7 @@ fn a_closed_stdout_is_not_an_error() {
 }
 
 /// A block one spacing wide holds one particle per axis, whatever the rounding of its corners
-/// (0.3 − 0.28 = 0.01999… was refused as narrower than the spacing 0.02).
+/// (0.3 − 0.28 = 0.01999… is not narrower than the spacing 0.02).
 #[test]
 fn a_block_one_spacing_wide_is_accepted() {
     let text = good()

@@ -1,6 +1,6 @@
 //! Effects (issue 3, item 6): a scene runs only the stages of the effects it asks for and
 //! allocates only their arrays, `isph plan` says so, parameters of an effect that is off are
-//! refused, and a scene without `[effects]` runs as before.
+//! refused, and a scene without `[effects]` runs as with every default spelled out.
 
 use crate::common::{run_scene, water_block_scene, TempDir};
 use isph::math::memory::Holds;

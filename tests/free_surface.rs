@@ -67,7 +67,7 @@ fn a_block_has_exactly_its_outer_layer_on_the_surface() {
 /// The whole range of h/dx a scene may ask for: a wider kernel reaches further out of the
 /// water, and the summation density of the second layer falls (0.86 ρ0 on a flat second row,
 /// 0.65 ρ0 at a 3D block's second-layer corner at h/dx = 2.0), but that layer is not spray.
-/// (With a spray threshold fixed at 0.9 ρ0 the corners were taken for free surface from
+/// (A spray threshold fixed at 0.9 ρ0 would take the corners for free surface from
 /// h/dx ≈ 1.3 on in 3D, and whole second rows from h/dx ≈ 1.75 on.)
 #[test]
 fn the_outer_layer_only_at_every_smoothing_length() {

@@ -11,7 +11,8 @@ fn still_water_has_hydrostatic_pressure_and_no_penetration() {
     let summary = run_scene(&scene, dir.path(), 1.0);
     let last = summary.frames.len() - 1;
     let m = measure(Case::Hydrostatic, &scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
-    // Measured: 2–5e-5 of ρgH at tolerance 1e-6 (docs/accuracy.md), bottom pressure likewise.
+    // Measured: 2–5e-5 of ρgH at tolerance 1e-6 (docs/accuracy.md, "Hydrostatic tank"), bottom
+    // pressure likewise.
     assert!(m.error < 0.005, "rms pressure error {} of ρgH", m.error);
     let bottom = m.details[0].1;
     assert!(bottom.abs() < 0.005, "bottom pressure error {bottom}");
@@ -28,8 +29,9 @@ fn still_water_has_hydrostatic_pressure_and_no_penetration() {
 
 /// A closed box full of water (no free surface: the pressure is pinned at one particle and
 /// shifted to a zero mean) stays at rest under gravity, its pressure rising by ρ g per metre
-/// of depth. Taking the walls' hydrostatic sources into the closed box's compression drove a
-/// flow towards the pinned particle: 0.26 m/s after 0.5 s here.
+/// of depth. It guards the balance of the closed box's compression: with the walls'
+/// hydrostatic sources taken into it, a flow runs towards the pinned particle
+/// (docs/stabilisation.md, "Water sealed off from the free surface").
 #[test]
 fn a_closed_box_full_of_water_stays_at_rest() {
     let text = crate::common::water_block_scene(0.5)
@@ -74,12 +76,12 @@ fn pressure_gradient(dir: &Path, frame: usize, keep: impl Fn(i32, f64) -> bool) 
 }
 
 /// A light fluid over water, 0.1 m of each, at rest: each layer keeps its own hydrostatic
-/// gradient. With the plain pressure differences across the interface (and the mass-weighted
-/// summation density, which took the water beside the oil for spray) oil at 800 kg/m³ set into
-/// motion, 0.22 m/s after 0.6 s, and its gradient reached 17 kPa/m. With the harmonic mean of
-/// 1/ρ across every pair and the Laplacian's consistency correction taking that weighting for
-/// kernel truncation, a fluid at half the water's density carried the water's gradient (87%
-/// too steep) and reached 0.26 m/s.
+/// gradient. It guards the weighting of the pairs across the interface: with plain pressure
+/// differences there (and a mass-weighted summation density, which takes the water beside the
+/// oil for spray) the oil is set into motion; with the harmonic mean of 1/ρ across every pair
+/// and the Laplacian's consistency correction taking that weighting for kernel truncation, a
+/// fluid at half the water's density carries the water's gradient and moves
+/// (docs/scene-format.md, "`[[fluid]]`").
 fn a_stable_layering_keeps_its_hydrostatic_pressure(light_density: f64) {
     let text = format!(
         r#"[simulation]
@@ -118,10 +120,10 @@ max = [0.5, 0.4]
     let dir = TempDir::new(&format!("layers-{light_density}"));
     let summary = run_scene(&scene, dir.path(), 0.6);
     // Measured: 1.06e-4 m/s at most at each density (the first steps; 6e-6 m/s at 0.6 s
-    // with 800 kg/m³ above, 6e-5 with 100), against √(gH) = 1.4 m/s. Before the walls stood
-    // for the fluid's mirror image in the distance to the interface and the pairs placed it
-    // halfway between their two distances (`interface::other_fluid_share`, `pair_weight`):
-    // 0.010, 0.029 and 0.069 m/s.
+    // with 800 kg/m³ above, 6e-5 with 100), against √(gH) = 1.4 m/s. Without the walls'
+    // mirror images in the distance to the interface and the pairs' placing of it halfway
+    // between their two distances (`interface::other_fluid_share`, `pair_weight`) the layers
+    // drift along the side walls (docs/scene-format.md, "`[[fluid]]`").
     let fastest = stats_column(dir.path(), "max_speed")
         .into_iter()
         .fold(0.0, f64::max);
@@ -151,20 +153,19 @@ fn a_fluid_at_half_the_density_of_water_keeps_its_hydrostatic_pressure() {
     a_stable_layering_keeps_its_hydrostatic_pressure(500.0);
 }
 
-/// A density ratio of 10: measured 1.06e-4 m/s at most (1.27 m/s, and the upper gradient 23%
-/// off, with the harmonic mean).
+/// A density ratio of 10: measured 1.06e-4 m/s at most (the harmonic mean instead:
+/// docs/scene-format.md, "`[[fluid]]`").
 #[test]
 fn a_fluid_at_a_tenth_of_the_density_of_water_keeps_its_hydrostatic_pressure() {
     a_stable_layering_keeps_its_hydrostatic_pressure(100.0);
 }
 
 /// Deeper layers, 0.25 m of a fluid at half the water's density over 0.25 m of water (H/20 per
-/// layer), held for 2 s: in a tank with side walls, and in a channel periodic along x. The
-/// layers beside the interface used to pair up in an exponential mode (growing ×2.8 every 0.45
-/// s, to 0.1–0.2 m/s) because each particle's distance to the interface overreacted to the
-/// other fluid's particles moving (`interface::pair_weight`). Measured over the second second:
-/// 7.6e-5 m/s at most with side walls (0.093 before, 0.027 with the walls' mirror images
-/// alone), 7e-7 periodic (0.010 before).
+/// layer), held for 2 s: in a tank with side walls, and in a channel periodic along x. It
+/// guards against the layers beside the interface pairing up in an exponential mode, which a
+/// distance to the interface that overreacts to the other fluid's particles moving drives
+/// (`interface::pair_weight`; docs/scene-format.md, "`[[fluid]]`"). Measured over the second
+/// second: 7.6e-5 m/s at most with side walls, 7e-7 periodic.
 fn a_deep_layering_stays_at_rest(periodic: bool, speed_bound: f64) {
     let scene = scene_from_text(&format!(
         "[simulation]\ndimensions = 2\nspacing = 0.0125\nend_time = 2.0\noutput_interval = 0.5\n\
@@ -202,10 +203,10 @@ fn a_deep_periodic_layering_stays_at_rest() {
 
 /// A tank parted by an obstacle from floor to lid: water fills the left compartment, sealed
 /// off from the free surface, and stands 0.2 m deep on the right. The sealed water has no
-/// pressure level of its own (its part of the PPE was singular: every solve ran to
-/// `max_iterations` and the run blew up at step 14); its highest particle is now pinned like
-/// a free surface. Measured: 1.3 PPE iterations a step, the water still to 6e-5 m/s over 3 s,
-/// the sealed pressure hydrostatic from its top.
+/// pressure level of its own (its part of the PPE is singular: without a reference every solve
+/// runs to `max_iterations`; docs/stabilisation.md, "Water sealed off from the free surface");
+/// its highest particle is pinned like a free surface. Measured: 1.3 PPE iterations a step,
+/// the water still to 6e-5 m/s over 3 s, the sealed pressure hydrostatic from its top.
 #[test]
 fn water_sealed_off_from_the_free_surface_stays_at_rest() {
     let scene = scene_from_text(
@@ -287,10 +288,10 @@ fn a_layer_too_thin_for_a_full_support_reports_no_density_error() {
 }
 
 /// Blocks stacked on a face through a lattice plane (y = 0.11 = container.min + 5.5 dx) fill
-/// that plane: its points belong to the first block, as their cells lie inside the two. They
-/// were in neither, and the empty layer took the planes beside it for free surface and the
-/// upper block fell into it (0.6 m/s within five steps in 3D). A lone block's face through a
-/// lattice plane keeps its points out, as before.
+/// that plane: its points belong to the first block, as their cells lie inside the two. It
+/// guards against an empty layer there, which has the planes beside it taken for free surface
+/// and lets the upper block fall into it (docs/scene-format.md, "`[[fluid_block]]`"). A lone
+/// block's face through a lattice plane keeps its points out.
 #[test]
 fn blocks_stacked_on_a_lattice_plane_leave_no_empty_layer() {
     let stacked = crate::common::water_block_scene(0.1)
@@ -324,10 +325,10 @@ fn blocks_stacked_on_a_lattice_plane_leave_no_empty_layer() {
 /// Still water in a 3D tank (0.3 × 0.2 m, 0.2 m deep, dx = 0.02 m) at the wide end of the
 /// allowed smoothing lengths. The particle at the top of the water where two side walls meet
 /// has the most truncated support that still needs its gradient correction; with the
-/// correction's determinant threshold fixed at 0.1 (set at h/dx = 1.2) it was taken for a
-/// splash from h/dx ≈ 1.75 (its lattice determinant is 0.098 at 1.8, 0.090 at 2.0), held at
-/// P = 0, and the four corners fell at 0.18 and 0.23 m/s. Measured now, over 0.3 s: 8e-4 m/s
-/// at 1.8, 1.4e-3 at 2.0 (8e-6 at 1.2).
+/// correction's determinant threshold fixed at 0.1 (set at h/dx = 1.2) it would be taken for
+/// a splash from h/dx ≈ 1.75 (its lattice determinant is 0.098 at 1.8, 0.090 at 2.0) and held
+/// at P = 0, and the four corners would fall (docs/accuracy.md, "Smoothing length above 1.5:
+/// still water"). Measured over 0.3 s: 8e-4 m/s at 1.8, 1.4e-3 at 2.0.
 #[test]
 fn still_water_in_a_3d_tank_stays_still_with_a_wide_kernel() {
     for h_over_dx in [1.8, 2.0] {

@@ -67,8 +67,8 @@ fn distances_on_a_lattice<const D: usize>(n: i64, h_over_dx: f64) {
 /// (the face at x = −½ dx), and in 3D at y ≤ −dx too (an edge of two walls), the fluid beyond.
 /// The particles beside the walls and at the edge read the distances of those beyond the
 /// walls' reach, to round-off: the walls stand for the mirror images of the fluid, and the
-/// image of a lattice is the lattice. Without the images the column beside a side wall missed
-/// part of the other fluid's share and read the first row 37% farther from the interface
+/// image of a lattice is the lattice. Without the images the column beside a side wall misses
+/// part of the other fluid's share and reads the first row 37% farther from the interface
 /// (0.73 spacings against 0.53 in 2D).
 fn distances_beside_side_walls<const D: usize>(n: i64) {
     let half = n / 2;

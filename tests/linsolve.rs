@@ -187,8 +187,8 @@ impl Aggregated<2> for Spray {
 }
 
 /// Cells whose unknowns couple to nothing have a zero diagonal on the coarse levels: the
-/// multigrid keeps them as cells holding unknowns (it panicked on them once, on the a/30
-/// impact at CFL 1.0) and BiCGSTAB with it converges.
+/// multigrid keeps them as cells holding unknowns (the a/30 impact at CFL 1.0
+/// has such cells) and BiCGSTAB with it converges.
 #[test]
 fn multigrid_takes_cells_whose_rows_couple_to_nothing() {
     let a = Spray;

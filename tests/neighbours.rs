@@ -116,8 +116,8 @@ fn periodic_axes_find_the_nearest_images_across_the_boundary() {
 }
 
 /// A period of 2.01 m at h = 0.01 m (a scene at dx = 0.01 m, h/dx = 1.0) is 134 cells of
-/// half a support whose width rounds one ulp below it: the reach across those cells, once
-/// rounded up to three, failed an assertion before any step ran.
+/// half a support whose width rounds one ulp below it: the reach across those cells must not
+/// round up to three, which fails an assertion before any step runs.
 #[test]
 fn periodic_cells_a_rounding_short_of_half_a_support() {
     check::<2>(3000, 0.01, [false, true], 2.01);

@@ -70,8 +70,8 @@ fn poiseuille_follows_the_start_up_series_and_converges() {
 }
 
 /// Along a periodic axis every position the frames hold lies in the period [min, max): the
-/// particles that left it in a step's advection are wrapped at the end of that step (they were
-/// written up to 1.2 mm outside a 0.5 m box). A dam break in a box periodic along x: the surge
+/// particles that left it in a step's advection are wrapped at the end of that step, before
+/// any frame is written. A dam break in a box periodic along x: the surge
 /// runs out through x = max and comes back in at x = min.
 #[test]
 fn frames_hold_periodic_positions_inside_the_box() {

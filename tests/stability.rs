@@ -70,10 +70,11 @@ fn assert_no_penetration(out: &Path) {
     );
 }
 
-/// 30 s, not the issue's 20: the mode the near-surface pressure reference removed
-/// (`step::pressure_reference`) let this tank reach 1.6e-3 m/s at 25 s and 0.56 m/s at 30 s;
-/// with it 2.3e-3 m/s at 30 s. A slower surface wave still grows (0.13 m/s at 40 s,
-/// docs/stabilisation.md).
+/// 30 s, not the issue's 20: without the near-surface pressure reference
+/// (`step::pressure_reference`) a surface mode makes this tank slosh between 25 and 30 s
+/// (docs/stabilisation.md, "The pressure reference near the free surface"). Measured:
+/// 2.3e-3 m/s at 30 s. A slower surface wave grows after that (docs/stabilisation.md, "Still
+/// water grows a surface mode").
 #[test]
 fn still_water_stays_at_rest_for_30_s() {
     // hydrostatic_2d.toml: 40 particles deep, H = 0.5 m.
@@ -154,11 +155,10 @@ fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize) {
 /// The issue's violent impact at a/40. After the plunge the flow is chaotic, so the worst step
 /// is one draw of a trajectory: a step cut short to land on a frame, or any change to the
 /// arithmetic, draws another. Measured over perturbed trajectories (frames every 0.05 s, the
-/// test, and 0.04, 0.03, 0.025 s; docs/stabilisation.md): at a/40 the worst step is 0.66–0.93%
-/// over four (0.64–0.84% over four more with one multigrid sweep), the mean over the steps
-/// 0.31–0.36%. Elsewhere the bound is broken on some trajectories: a/25 1.29%, a/30
-/// 0.95–1.12% (two of four above), a/50 0.58–0.75% on three but 1.09% on one of three more
-/// (water coming apart in a corner where the pressure is cut at zero).
+/// test, and 0.04, 0.03, 0.025 s): at a/40 the worst step is 0.66–0.93% over four, the mean
+/// over the steps 0.31–0.36%. At a/25, a/30 and a/50 the bound is broken on some trajectories
+/// (docs/stabilisation.md, "The violent impact: a/40 meets the bound on every trajectory
+/// measured").
 #[test]
 fn violent_impact_keeps_density_and_volume() {
     let (dir, frames) = violent_impact(40.0, "", "impact");
@@ -258,10 +258,12 @@ fn high_viscosity_stays_smooth() {
 
 /// The violent impact at CFL 0.5 and 1.0 (the default is 0.2): no NaN, rare face crossings, no
 /// energy created, and the mean density error bounded — 0.73% on average over the steps at
-/// 0.5 (0.8–0.9% before the near-surface pressure reference of `step::pressure_reference`),
-/// 1.29% at 1.0 (1.40% on a trajectory with frames every 0.04 s; a larger step lets more
-/// compression through before the projection catches it): asserted below 1% and 2.5%. Without
-/// the cap on the shift's diffusion number (`shifting`) the mean at 1.0 was 2.8%.
+/// 0.5, 1.29% at 1.0 (1.40% on a trajectory with frames every 0.04 s; a larger step lets more
+/// compression through before the projection catches it): asserted below 1% and 2.5%. The
+/// test guards the near-surface pressure reference (`step::pressure_reference`) and the cap on
+/// the shift's diffusion number (`shifting`), without which the mean is larger
+/// (docs/stabilisation.md, "The pressure reference near the free surface" and "Particle
+/// shifting").
 #[test]
 fn large_cfl_numbers_stay_stable() {
     for (cfl, bound) in [(0.5, 0.01), (1.0, 0.025)] {
@@ -284,10 +286,10 @@ fn large_cfl_numbers_stay_stable() {
 }
 
 /// The 3D dam break over an obstacle standing on the floor, coarse (dx = 0.05 m, 480 fluid
-/// particles): no particle crosses a wall face. (116 crossed in 226 steps while the obstacle's
-/// face on the floor counted as a face, its edge particles took the normal of one face only,
-/// and the kinematic condition followed the nearest wall particle's normal instead of the
-/// faces' geometry.)
+/// particles): no particle crosses a wall face. It guards the faces' geometry: the obstacle's
+/// face on the floor is no face, its edge particles take the normalised sum of their faces'
+/// normals, and the kinematic condition follows the faces, not the nearest wall particle's
+/// normal (docs/stabilisation.md, "The kinematic wall condition and wall crossings").
 #[test]
 fn dam_break_3d_with_obstacle_runs_1_s() {
     let s = scene(

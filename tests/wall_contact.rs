@@ -132,7 +132,8 @@ fn a_particle_touching_a_face_keeps_no_velocity_into_it() {
 
 /// An obstacle whose faces pass through lattice points (x = 0.05 = container.min + 2.5 dx):
 /// no fluid particle starts on a face or closer than half a spacing to it, and none crosses it.
-/// Before, the particles on its faces were pushed back and counted as crossings (9 in 0.1 s).
+/// It guards against fluid starting on the faces, which the contact pushes back and counts as
+/// crossings (docs/scene-format.md, "`[[obstacle]]`").
 #[test]
 fn an_obstacle_with_faces_through_lattice_points_starts_and_stays_clear_of_fluid() {
     let text = crate::common::water_block_scene(0.1).replace(

@@ -8,17 +8,18 @@
 //! wall neighbour b as the continuation of its own pressure field under the Neumann condition
 //! of the projection, ∂P/∂n = ρ0 (g − a_b)·n:
 //!
-//!   P_b = P_i + ρ0 (g − a_b)·N_b (r_b − r_i),                                               (ghost)
+//!   P_b = P_i + ρ0 (g − a_b)·N_b (r_b − r_i),                                         (ghost)
 //!
 //! N_b the projector on the normals of the walls b lies behind: n nᵀ behind a plane wall, the
-//! identity in a corner of the container (behind two walls in 2D, three in 3D; behind two
-//! walls of a 3D box, the projector on their plane). The walls are axis-aligned (container and
-//! box obstacles), so N_b keeps the axes along which b's normal has a component. Only the
-//! normal part of the hydrostatic gradient is carried into the wall: along the wall the fluid
-//! may be accelerating (a column falling beside a wall, a surge running along the floor), and a
-//! hydrostatic gradient along the wall there would suck fluid into dry wall above it. Because the ghost difference P_b − P_i does
-//! not depend on the unknowns, the wall pairs of a PPE row are known numbers: the Neumann condition
-//! becomes a source term and the matrix couples fluid particles only.
+//! identity in a corner of the container (behind two walls in 2D, three in 3D; behind two walls of
+//! a 3D box, the projector on their plane). The walls are axis-aligned (container and box
+//! obstacles), so N_b keeps the axes along which b's normal has a component. Only the normal part
+//! of the hydrostatic gradient is carried into the wall: along the wall the fluid may be
+//! accelerating (a column falling beside a wall, a surge running along the floor), and a
+//! hydrostatic gradient along the wall there would suck fluid into dry wall above it. Because the
+//! ghost difference P_b − P_i does not depend on the unknowns, the wall pairs of a PPE row are
+//! known numbers: the Neumann condition becomes a source term and the matrix couples fluid
+//! particles only.
 //!
 //! The kinematic condition u·n = 0 enters the PPE source through the velocity divergence, where
 //! the wall particles take the wall velocity (zero) plus the fluid particle's own predictor
@@ -108,7 +109,8 @@ pub fn ghost_velocity<const D: usize>(
 /// velocity on the face itself, so the difference is β (u_i − u_wall) with
 /// β = 1 + d_b/d_i = n_b·r_ib/d_i, capped at `MORRIS_BETA_MAX` for the wall particles deep
 /// behind the face. (Walls simply at rest, β = 1, put the no-slip line about half a spacing
-/// behind the face: a Poiseuille channel 20 particles wide then flows 12% too fast.)
+/// behind the face, and a Poiseuille channel flows too fast: docs/accuracy.md, "Poiseuille
+/// flow".)
 #[inline(always)]
 pub fn no_slip_difference<const D: usize>(
     p: &Particles<D>,
@@ -126,7 +128,8 @@ pub fn no_slip_difference<const D: usize>(
 
 /// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right
 /// at the face (d_i → 0); here d_i ≥ dx/4 (`Face::distance`) bounds β anyway, and a cap of 1.5
-/// leaves the Poiseuille channel 4.2% too fast (4: 0.48%, no cap: 0.47%).
+/// leaves the Poiseuille channel too fast where 4 is as good as no cap (docs/accuracy.md,
+/// "Poiseuille flow").
 const MORRIS_BETA_MAX: f64 = 4.0;
 
 /// What the ghost pressures of the walls are made of, borrowed apart from the pressures

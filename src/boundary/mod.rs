@@ -3,4 +3,4 @@
 //! from a boundary particle in every operator.
 
 pub mod faces;
-pub mod ghosts;
+pub(crate) mod ghosts;

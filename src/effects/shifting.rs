@@ -12,9 +12,9 @@
 //! * D is capped at `MAX_DIFFUSION_NUMBER` h²: the shift is one explicit step of a diffusion
 //!   of the particle concentration (δC ≈ D ∇²C), stable only below a diffusion number of about
 //!   one, and with U Δt ≤ C h the number A h U Δt / h² reaches A·C, 0.4 at the defaults but 2
-//!   at CFL 1.0. Measured on the a/30 impact (docs/stabilisation.md): at CFL 1.0 the cap halves
-//!   the mean density error (2.8% → 1.3–1.4%); at CFL 0.5 it changes nothing measurable; at
-//!   the default CFL 0.2 it never acts.
+//!   at CFL 1.0. On the a/30 impact the cap lowers the mean density error at CFL 1.0 and
+//!   changes little at CFL 0.5 (docs/stabilisation.md, "Particle shifting"); at the default
+//!   CFL 0.2 it never acts.
 //! * Where the free surface truncates the kernel support, ∇C points out of the fluid; there
 //!   only the part tangential to the surface is kept (normal of `free_surface`).
 //! * Each component is capped at 0.1 dx.

@@ -1,8 +1,8 @@
 //! The SIMD vector every pair loop computes in: `LANES` f64 lanes of `wide`, as wide as the
 //! CPU the build targets. `.cargo/config.toml` builds for the host (`target-cpu=native`), so a
 //! build on an AVX-512 machine gets eight lanes in one zmm register and a build on an AVX2
-//! machine four in one ymm register (eight there would be two ymm registers per operation, and
-//! measured 15% slower than four: docs/performance.md).
+//! machine four in one ymm register (eight there would be two ymm registers per operation,
+//! slower than four: docs/performance.md, "Build").
 //!
 //! The width does not change the results: the pair loops sum into a `Sum`, which adds a
 //! chunk's lanes four at a time in index order, so builds of either width give the same bits

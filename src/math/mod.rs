@@ -2,10 +2,10 @@
 //! vectors, SIMD lanes, thread-count-independent parallel loops and sums, the kernel of Eq. (19),
 //! the walk over lattice points, and the sizes of arrays.
 
-pub mod aabb;
+pub(crate) mod aabb;
 pub mod kernel;
 pub mod lanes;
-pub mod lattice;
+pub(crate) mod lattice;
 pub mod memory;
 pub mod reduce;
 pub mod vector;

@@ -5,10 +5,10 @@
 //! The cells are a quarter of the support R along x and half of it across (`SUBDIVISION`). The
 //! neighbours of a particle at x lie in the rows of cells across x whose slab comes within R of
 //! it, and in each row in the cells within √(R² − d²) of x along the row, d the distance from x
-//! to the row's slab: about 2.2 candidates per neighbour in 3D, against 6.4 for the 27 cells one
-//! support wide around x. Every 4 × 2 × 2 cells (4 × 2 in 2D) form one block at least one
-//! support wide: the aggregates of the PPE's multigrid (`blocks`), whose stencil then reaches
-//! the adjacent blocks only.
+//! to the row's slab: far fewer candidates per neighbour than the 27 cells one support wide
+//! around x hold (docs/performance.md, "The PPE apply"). Every 4 × 2 × 2 cells (4 × 2 in 2D)
+//! form one block at least one support wide: the aggregates of the PPE's multigrid
+//! (`blocks`), whose stencil then reaches the adjacent blocks only.
 
 use crate::math::memory::ArraySize;
 use crate::particles::Kind;
@@ -542,9 +542,10 @@ const RUN_CELLS_BITS: u32 = 10;
 
 /// The runs of cells around every fluid particle, found once per `CellList::sort`: a step's
 /// pair loops visit a fluid particle's neighbours many times (the PPE apply alone thirty times
-/// and more), and searching the grid each time cost about as much as the pair arithmetic of
-/// the apply (docs/performance.md). About 20 runs of 6 bytes per fluid particle in 3D; the
-/// pairs themselves are never stored.
+/// and more), and finding the runs once makes the apply faster than searching the grid in
+/// every pair loop (docs/performance.md, "The PPE apply"). A run takes 6 bytes (the runs per
+/// fluid particle: docs/performance.md, "Memory per particle"); the pairs themselves are never
+/// stored.
 #[derive(Clone, Debug, Default)]
 struct Runs {
     /// The runs of sorted fluid particle k are `end[k − 1]..end[k]` (from 0 for k = 0).

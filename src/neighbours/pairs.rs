@@ -1,10 +1,10 @@
-//! The pair loop every operator is built on. The particles are sorted by kind and cell (`cell_list`),
-//! so the neighbours of particle i lie in a few contiguous index ranges, one per row of cells
-//! within reach and kind (operators that need one kind only visit its ranges); the loop walks each range
-//! `LANES` particles at a time in SIMD lanes (`lanes::F64s`): positions are loaded contiguously,
-//! the distance test and the kernel are evaluated for `LANES` pairs at once, and each operator
-//! accumulates in lanes, summed at the end in a fixed order. Lanes past the end of a range (and
-//! past the end of the arrays, which read far-away sentinels) are masked off.
+//! The pair loop every operator is built on. The particles are sorted by kind and cell
+//! (`cell_list`), so the neighbours of particle i lie in a few contiguous index ranges, one per row
+//! of cells within reach and kind (operators that need one kind only visit its ranges); the loop
+//! walks each range `LANES` particles at a time in SIMD lanes (`lanes::F64s`): positions are loaded
+//! contiguously, the distance test and the kernel are evaluated for `LANES` pairs at once, and each
+//! operator accumulates in lanes, summed at the end in a fixed order. Lanes past the end of a range
+//! (and past the end of the arrays, which read far-away sentinels) are masked off.
 //!
 //! `for_each` offers the same walk one neighbour at a time, for the operators that run once per
 //! step; the hot loops (the PPE apply, density, …) work on the lanes directly.

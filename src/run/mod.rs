@@ -2,7 +2,7 @@
 //! directory. `run` starts one; `resume` continues one from a checkpoint, bit for bit as if it
 //! had never stopped.
 
-pub mod progress;
+pub(crate) mod progress;
 pub mod resume;
 
 use crate::io::checkpoint::{Checkpoint, CheckpointError, RunState};
@@ -202,11 +202,11 @@ struct Driver<'a, const D: usize> {
 /// Steps beyond which `isph run` warns at start that the run is very long.
 const MANY_STEPS: f64 = 1.0e7;
 
-/// `time`, or the multiple k × `interval` (k ≥ 1) within `FRAME_TIME_ROUNDING` intervals of it, as the
-/// frames' schedule computes it: a run ends on the frame it lands on anyway. So a run stopped
-/// at `--until 0.3` and resumed takes the very steps of one that ran through that frame,
-/// scheduled at 3 × 0.1 = 0.30000000000000004 (landing on 0.3 itself, the steps before it
-/// differed in their last bits, and the continued run from there on).
+/// `time`, or the multiple k × `interval` (k ≥ 1) within `FRAME_TIME_ROUNDING` intervals of it, as
+/// the frames' schedule computes it: a run ends on the frame it lands on anyway. So a run stopped
+/// at `--until 0.3` and resumed takes the very steps of one that ran through that frame, scheduled
+/// at 3 × 0.1 = 0.30000000000000004 (landing on 0.3 itself, the steps before it would differ in
+/// their last bits, and the continued run from there on).
 fn on_frame(time: f64, interval: f64) -> f64 {
     let k = (time / interval).round();
     let multiple = k * interval;
@@ -268,8 +268,8 @@ impl<'a, const D: usize> Driver<'a, D> {
     /// `next_output × output_interval`: the scheduled time, or the end time if it comes first.
     /// A scheduled time within `FRAME_TIME_ROUNDING` intervals of the end time is the end time
     /// (0.03 × 11 = 0.32999999999999996 against an end time of 0.33), so that no step is
-    /// shortened to a sliver between the two: a step of 1e-17 s makes the pressure solve's
-    /// 1/Δt² terms blow the flow up.
+    /// shortened to a sliver between the two: the pressure solve divides by Δt, and a step of
+    /// order 1e-17 s blows the flow up (docs/stabilisation.md, "A short step relaxes less").
     fn next_frame(&self) -> (f64, bool) {
         let interval = self.scene.output_interval;
         let scheduled = self.next_output as f64 * interval;

@@ -13,17 +13,15 @@
 //!
 //! A level is held over its active cells only, the cells holding unknowns, in compressed rows:
 //! in a tank that is mostly air or dry wall the empty cells would otherwise cost as much as the
-//! water (`dam_break_2d`: 1,700 cells on level 1 for 1,800 fluid particles).
+//! water (docs/performance.md, "The pressure solve").
 //!
 //! On the particles the two parts are added, not applied one after the other (an additive
 //! two-level method): z = D⁻¹ r + s P V(Pᵀ r), V the V-cycle of level 1. A multiplicative
 //! cycle (smooth, correct, smooth) converges in fewer iterations but applies the particle
 //! operator twice per preconditioner call, four times per BiCGSTAB iteration on top of
-//! BiCGSTAB's own two; the additive one applies it never. Measured on the 3D dam break at 10⁴
-//! and 10⁵ fluid particles, with one smoothing sweep: 14.5 and 17.5 BiCGSTAB iterations per
-//! step against 10 and 11.5, the pressure solve about 1.5 times faster (docs/performance.md).
-//! The weight s of the coarse part (`COARSE_WEIGHT`) was picked on those runs (s = 0.5 … 1.6:
-//! 16.5 … 22.5 iterations at 10⁵).
+//! BiCGSTAB's own two; the additive one applies it never. On the 3D dam break the additive
+//! cycle takes more BiCGSTAB iterations but solves faster; the weight s of the coarse part
+//! (`COARSE_WEIGHT`) is picked on the same runs (docs/performance.md, "The pressure solve").
 //!
 //! The preconditioner is a fixed linear map of the residual, as BiCGSTAB needs, and every sum
 //! runs in a fixed order: the result does not depend on the thread count.
@@ -44,11 +42,9 @@ const COARSE_WEIGHT: f64 = 0.85;
 const COARSEST: usize = 64;
 /// Jacobi sweeps on the coarsest level.
 const COARSEST_SWEEPS: usize = 40;
-/// Jacobi sweeps before and after the coarse correction on the other structured levels. On
-/// the 3D dam break, 3 sweeps instead of 1 take BiCGSTAB from 19.5 to 14.0 iterations per step
-/// at 10⁵ fluid particles and from 23.0 to 16.5 at 10⁶ (2: 14.7 and 8: 13.0 at 10⁵), the step
-/// 16% faster; held over the active cells only they make the 2D default scene faster too
-/// (docs/performance.md).
+/// Jacobi sweeps before and after the coarse correction on the other structured levels: on
+/// the 3D dam break three take far fewer BiCGSTAB iterations than one, for a faster step, and
+/// more save little (docs/performance.md, "The pressure solve").
 const SMOOTHING_SWEEPS: usize = 3;
 /// A diagonal at most this fraction of its row's Σ|a| is taken for zero: a cell whose unknowns
 /// couple only to each other has a coarse diagonal that is zero in exact arithmetic, and its

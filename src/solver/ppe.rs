@@ -147,9 +147,9 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 /// The per-row vector of the operator, with L'_i the correction of the pressure gradient
 /// (`sph::Moments::m_neumann`): ĉ_i = L'_iᵀ c_i of the consistent Laplacian for interior rows
 /// (see `laplacian_correction`), zero otherwise. Deep inside the fluid c_i measures the
-/// disorder of the particles, and the row is corrected all the same: leaving those rows
-/// uncorrected let still water go unstable after about a second (max speed growing threefold
-/// every 0.17 s in `hydrostatic_2d`), with it the tank stays at rest.
+/// disorder of the particles, and the row is corrected all the same: left uncorrected, those
+/// rows let still water go unstable within seconds, and with the correction the tank stays at
+/// rest (docs/stabilisation.md, "The free-surface and interior rows of the PPE").
 pub fn row_vectors<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
@@ -167,11 +167,10 @@ pub fn row_vectors<const D: usize>(
 /// Pressure of a free-surface particle: the surface itself lies about δ = dx/2 beyond the
 /// particle's centre, so P = 0 there puts P_i = ρ0 |g| δ, the weight of the water above the
 /// centre (exact in still water; where the true P_i is 0, as in a free-falling jet, it errs by
-/// ρ0 |g| dx/2 at most). Two ways of following the surface's orientation were measured and
-/// dropped on `hydrostatic_2d` run for 20 s: ρ0 δ (−g·n)⁺ with n the surface normal, and the
-/// Robin row P_i + δ n·∇P_i = 0; both let the surface layer oscillate with a slowly growing
-/// amplitude (max speed 0.01 and 0.5 m/s after 20 s), this constant keeps the tank at rest
-/// (below 1e-4 m/s).
+/// ρ0 |g| dx/2 at most). The rows that follow the surface's orientation, ρ0 δ (−g·n)⁺ with n
+/// the surface normal and the Robin row P_i + δ n·∇P_i = 0, let the surface layer of
+/// `hydrostatic_2d` oscillate with a slowly growing amplitude; this constant keeps the tank at
+/// rest (docs/stabilisation.md, "The free-surface and interior rows of the PPE").
 fn surface_pressure(rest_density: f64, gravity: f64, spacing: f64) -> f64 {
     rest_density * gravity * 0.5 * spacing
 }
@@ -242,8 +241,9 @@ pub fn source<const D: usize>(
 /// sum (from the disorder of the particles); its mean over the interior rows `b` (their
 /// compression only), which `source` removes from each. The walls' known differences are not
 /// compression and stay out of it: under gravity they are what holds the hydrostatic pressure
-/// up, and taking their net sum out as well drove a flow towards the reference (0.35 m/s after
-/// 0.5 s in a 0.5 × 0.4 m box full of water). Water sealed off from the free surface is such a
+/// up, and taking their net sum out as well drives a flow towards the reference
+/// (`tests/hydrostatic.rs`, `a_closed_box_full_of_water_stays_at_rest`; docs/stabilisation.md,
+/// "Water sealed off from the free surface"). Water sealed off from the free surface is such a
 /// box of its own: the mean is over the interior rows among `count` rows, row k being
 /// `row(k)`.
 fn net_compression(
@@ -271,8 +271,10 @@ fn net_compression(
 /// that it is exact for linear velocity fields also where the free surface truncates the kernel.
 /// `density_rate` is α/Δt_max. A full step (Δt = Δt_max) is Eq. (6) as printed; a step cut
 /// short to land on a frame relaxes the density error by the fraction α Δt/Δt_max of it, at
-/// the same rate per unit time. With α/Δt² the velocity the term corrects by grows as 1/Δt:
-/// a last step of 4e-8 s (an end time just past a frame) ended a dam break at 78 m/s.
+/// the same rate per unit time. With α/Δt² the velocity the term corrects by grows as 1/Δt,
+/// and a short last step (an end time just past a frame) kicks the flow (`tests/frame_times.rs`,
+/// `a_short_last_step_does_not_kick_the_flow`; docs/stabilisation.md, "A short step relaxes
+/// less").
 #[allow(clippy::too_many_arguments)]
 fn divergence_source<const D: usize>(
     nb: &Neighbours<D>,
@@ -331,13 +333,13 @@ fn volume_mass<const D: usize>(
 /// kernel support, Eq. (27) applied to a linear field P is not zero but −c_i·∇P_i, with c_i = 2 Σ_j
 /// (m_j/ρ_i) r_ij r_ij·∇W_ij/(r_ij² + η²) (zero for a full support; every neighbour counted as one
 /// of i's own fluid, m_j = ρ0_i V_j, where the fluids differ). A wall ghost continues only the
-/// normal part of the field, so a wall neighbour contributes N_b r_ij (see `boundary::ghosts`): beside a plane
-/// wall the wall supplies what the missing fluid would, but in a corner or where the surface meets
-/// a wall the support is truncated for the tangential part too. Subtracting that term, with ∇P_i
-/// the corrected gradient L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij − V_j
-/// (L_iᵀc_i)·∇W_ij)(P_i − P_j), still one pass over the neighbours. Without it the pressure bends
-/// under the free surface and pushes a still surface off its rest position. Returns ĉ_i = L_iᵀ c_i,
-/// with L_i the pressure gradient correction.
+/// normal part of the field, so a wall neighbour contributes N_b r_ij (see `boundary::ghosts`):
+/// beside a plane wall the wall supplies what the missing fluid would, but in a corner or where the
+/// surface meets a wall the support is truncated for the tangential part too. Subtracting that
+/// term, with ∇P_i the corrected gradient L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij −
+/// V_j (L_iᵀc_i)·∇W_ij)(P_i − P_j), still one pass over the neighbours. Without it the pressure
+/// bends under the free surface and pushes a still surface off its rest position. Returns ĉ_i =
+/// L_iᵀ c_i, with L_i the pressure gradient correction.
 fn laplacian_correction<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,

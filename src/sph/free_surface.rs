@@ -24,10 +24,10 @@
 //!    that blows the spray apart.
 //! 4. A particle whose summation density exceeds ρ0 is never free surface, whatever the other
 //!    rules say: a truncated support holds less mass than a full one, so one that holds more
-//!    is compressed, and a free-surface row (a fixed pressure) cannot push back. At the tip of
-//!    a surge on a no-slip floor (ν = 1e-3 m²/s, dx = 0.01 m) a particle was squeezed to
-//!    1.12 ρ0 between the floor and the water behind it; its row then answered with 4.9 kPa
-//!    and shot it out at 2.8 m/s, 35% faster than the front (2.1 m/s with this rule).
+//!    is compressed, and a free-surface row (a fixed pressure) cannot push back. A particle
+//!    squeezed between a no-slip floor and the water behind it at the tip of a surge would
+//!    otherwise answer with a pressure spike that shoots it out ahead of the front
+//!    (docs/stabilisation.md, "Compressed fluid is never free surface").
 
 use crate::math::kernel::Quintic;
 use crate::math::lattice::for_each_lattice_point;
@@ -51,9 +51,9 @@ const SPRAY_H_OVER_DX: f64 = 1.2;
 /// truncated particle that is not on the surface of a block of fluid, the corner of its
 /// second layer, which the rule must leave alone. A wider kernel reaches further out of the
 /// water: that corner holds 0.98 ρ0 at h/dx = 1.0, 0.93 at 1.2, 0.82 at 1.5 and 0.65 at 2.0 in
-/// 3D (0.99, 0.95, 0.87, 0.74 in 2D), so a fixed 0.9 took it, and from h/dx ≈ 1.75 on a whole
-/// flat second row, for spray, fixed their pressure at the surface's and let the water's top
-/// fall.
+/// 3D (0.99, 0.95, 0.87, 0.74 in 2D), so a fixed 0.9 would take it, and from h/dx ≈ 1.75 on a
+/// whole flat second row, for spray, fix their pressure at the surface's and let the water's
+/// top fall (docs/accuracy.md, "Smoothing length above 1.5: still water").
 pub fn spray_density<const D: usize>(h_over_dx: f64) -> f64 {
     SPRAY_DENSITY
         * (second_corner_density::<D>(h_over_dx) / second_corner_density::<D>(SPRAY_H_OVER_DX))

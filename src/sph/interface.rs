@@ -8,11 +8,12 @@
 //! interface. The harmonic mean 2/(ρ0_i + ρ0_j) of 1/ρ (Cummins & Rudman 1999) is the case
 //! f = ½, exact only where the interface lies halfway between the two; the kernel's support
 //! (3.6 spacings at h/dx = 1.2) holds pairs crossing it anywhere along their length. With
-//! f = ½ a stable layering of a fluid at half the water's density over water reached 0.19 m/s
-//! in 0.6 s where this one stays at 1e-4 (`tests/hydrostatic.rs`; `ppe::laplacian_correction`
-//! and `PressureOperator::interior_weights` for the other half of that fix). f comes from each
-//! particle's distance to the interface d_i (`Interfaces::distance`) and its normal across it
-//! (`other_fluid_share`): `pair_weight`.
+//! f = ½ a stable layering of a fluid at half the water's density over water is set in motion,
+//! with this f it stays at rest (`tests/hydrostatic.rs`,
+//! `a_fluid_at_half_the_density_of_water_keeps_its_hydrostatic_pressure`; docs/scene-format.md,
+//! "`[[fluid]]`"; `ppe::laplacian_correction` and `PressureOperator::interior_weights` for the
+//! other half of the weighting). f comes from each particle's distance to the interface d_i
+//! (`Interfaces::distance`) and its normal across it (`other_fluid_share`): `pair_weight`.
 
 use crate::math::kernel::Quintic;
 use crate::math::lanes::F64s;
@@ -104,12 +105,11 @@ impl Interfaces {
 /// (`faces`, `Faces::container_faces_within`) stand for the mirror image of the fluid, as
 /// their ghost pressures do: each fluid neighbour j of the other density counts once more at
 /// each of its images, across every set of those faces (across one face beside a wall, two at
-/// an edge, three in a corner). Without the images a particle beside a side wall missed the
-/// part of the other fluid's share that lies behind the wall, took itself for 37% farther from
-/// an interface at its height than it is (`tests/interface.rs`), and the pairs across it for
-/// the wrong density: the layerings of `tests/hydrostatic.rs` drifted along their side walls at
-/// 0.010, 0.029 and 0.069 m/s within 0.6 s (upper fluid at 800, 500 and 100 kg/m³ over water),
-/// 1.4e-4, 6.5e-4 and 7.5e-3 m/s with the images (1.1e-4 with `pair_weight`'s rule as well).
+/// an edge, three in a corner). Without the images a particle beside a side wall misses the
+/// part of the other fluid's share that lies behind the wall, takes itself for 37% farther
+/// from an interface at its height than it is (`tests/interface.rs`, on a lattice), and the
+/// pairs across it for the wrong density: the layerings of `tests/hydrostatic.rs` then drift
+/// along their side walls (docs/scene-format.md, "`[[fluid]]`").
 /// The obstacles' faces are not mirrored.
 pub fn other_fluid_share<const D: usize>(
     nb: &Neighbours<D>,
@@ -163,10 +163,10 @@ pub struct Field<'a, const D: usize> {
 /// The disagreement is that of particles that moved: a distance read off the other fluid's
 /// mass moves with that fluid's particles as much as with i, so when the two layers beside an
 /// interface close in by 2ε each reads itself 2ε nearer to it, against ε in truth. The ratio
-/// f = d_i/(d_i + d_j), which ignores L, turned that error into a pressure gradient pulling
-/// the two layers further together: a layering at half the water's density paired its layers
-/// near the interface in an exponential mode (growth ×2.8 every 0.45 s) that stirred it at
-/// 0.1–0.2 m/s.
+/// f = d_i/(d_i + d_j), which ignores L, turns that error into a pressure gradient pulling the
+/// two layers further together: a layering at half the water's density pairs its layers near
+/// the interface in a growing mode (`tests/hydrostatic.rs`,
+/// `a_deep_layering_beside_side_walls_stays_at_rest`; docs/scene-format.md, "`[[fluid]]`").
 #[inline(always)]
 pub fn pair_weight(
     rest_density_i: F64s,

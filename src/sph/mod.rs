@@ -90,8 +90,8 @@ pub fn viscous_acceleration<const D: usize>(
     acc.map(|a| a.total())
 }
 
-/// Corrected gradient of a velocity field, G[b][a] = ∂u_a/∂x_b = Σ_c L_bc Σ_j V_j (u_j − u_i)_a ∂_c W_ij
-/// (Eq. 20 with Eq. 24–25), with `u_i` the velocity of particle i and `u(l)` the velocities
+/// Corrected gradient of a velocity field, G[b][a] = ∂u_a/∂x_b = Σ_c L_bc Σ_j V_j (u_j − u_i)_a ∂_c
+/// W_ij (Eq. 20 with Eq. 24–25), with `u_i` the velocity of particle i and `u(l)` the velocities
 /// taken for the neighbours in lanes `l`.
 pub fn velocity_gradient<const D: usize>(
     nb: &Neighbours<D>,
@@ -145,8 +145,10 @@ const CORRECTION_H_OVER_DX: f64 = 1.2;
 /// that must keep its correction, the top of the water where two side walls meet (in 2D,
 /// where the surface meets a wall). Its lattice determinant falls as the kernel reaches
 /// further (3D: 0.148 at h/dx = 1.2, 0.116 at 1.5, 0.098 at 1.8, 0.090 at 2.0), and a fixed 0.1
-/// took that particle for a splash from h/dx ≈ 1.75: its pressure went to 0, and the corners
-/// of still water in a 3D tank fell at 0.2 m/s.
+/// would take that particle for a splash from h/dx ≈ 1.75, set its pressure to 0 and let the
+/// corners of still water in a 3D tank fall (`tests/hydrostatic.rs`,
+/// `still_water_in_a_3d_tank_stays_still_with_a_wide_kernel`; docs/accuracy.md, "Smoothing
+/// length above 1.5: still water").
 pub fn min_correction_determinant<const D: usize>(h_over_dx: f64) -> f64 {
     MIN_CORRECTION_DETERMINANT
         * (wall_corner_determinant::<D>(h_over_dx)

@@ -35,8 +35,8 @@ impl<const D: usize> CellSort<D> {
 
     /// Sorts `p` by cell; a particle outside the grid is an error.
     pub fn run(&mut self, p: &mut Particles<D>) -> Result<(), StepError> {
-        // (A no-op after a step; a checkpoint written before steps wrapped may hold positions
-        // past the period.)
+        // (A no-op after a step, which wraps the positions it moves; a checkpoint may still hold
+        // positions past the period.)
         self.grid.wrap(&mut p.pos);
         self.grid
             .sort(&p.pos, &p.kind, &mut self.cell_of, &mut self.order)

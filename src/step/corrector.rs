@@ -88,8 +88,9 @@ impl<const D: usize> Stage<D> for Corrector<D> {
 
 /// Distance from a wall face within which a fluid particle touches it (the kinematic condition
 /// of `Faces::no_penetration`): half a spacing, the distance at which the fluid's first layer
-/// rests, and a hair more so that the resting layer is included (docs/stabilisation.md has
-/// the still tank and the violent impact at other distances).
+/// rests, and a hair more so that the resting layer is included (the still tank and the
+/// violent impact at other distances: docs/stabilisation.md, "The kinematic wall condition and
+/// wall crossings").
 pub fn touching_distance(spacing: f64) -> f64 {
     0.5001 * spacing
 }
@@ -134,9 +135,9 @@ fn pressure_gradient<const D: usize>(
 /// whose pressure dips below its neighbours' is pushed towards the surface, and the projection
 /// feeds the velocity that lowered its pressure. On the still tank of `hydrostatic_2d` the
 /// step's velocity map, u ← u − (Δt/ρ0)∇P of the PPE of u, then amplifies a zig-zag of the row
-/// under the surface by 0.32% per step (its largest eigenvalue at rest, by power iteration),
-/// and the tank sloshes after 28 s; with P̃_i the largest eigenvalue is 1, the divergence-free
-/// fields' (docs/stabilisation.md).
+/// under the surface (its largest eigenvalue at rest, by power iteration, exceeds 1), and the
+/// tank sloshes; with P̃_i the largest eigenvalue is 1, the divergence-free fields'
+/// (docs/stabilisation.md, "The pressure reference near the free surface").
 fn pressure_reference<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,

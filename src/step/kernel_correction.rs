@@ -4,8 +4,9 @@
 //! Inside the fluid (no free surface in reach) the moment matrix measures the disorder of the
 //! particles, not a truncated support: corrected there, the divergence of the PPE source
 //! amplifies that disorder into the pressure (a collision of two blocks then gains energy
-//! instead of losing it, docs/stabilisation.md). So L_i is kept only where the free surface is
-//! in reach, and stored for those particles only (a few per cent of a large run): their slots
+//! instead of losing it: docs/stabilisation.md, "Near the free surface only: the divergence
+//! correction and the Taylor step"). So L_i is kept only where the free surface is in reach,
+//! and stored for those particles only (a few per cent of a large run): their slots
 //! are given out in index order, then L_i is inverted from the moments of each. The pressure
 //! gradient keeps its correction L'_i everywhere (`free_surface`), which inside the fluid
 //! corrects the wall ghosts' missing tangential gradient.

@@ -258,6 +258,7 @@ impl<const D: usize> Step<D> {
         let (solve, density_error, disorder, shift) = {
             let nb = Neighbours::new(self.cell_list.grid(), &p.pos, self.kernel);
             let density = self.density.run(&nb, p, nf);
+            // Into the particles: ρ.
             p.density[..nf].copy_from_slice(density);
             let interfaces = self.density.interfaces(&nb, p, &self.faces, nf);
             laps.lap(density::NAME);
@@ -296,12 +297,14 @@ impl<const D: usize> Step<D> {
             let surface = self.free_surface.output();
             let clip = surface.reference.is_none();
             let solved = self.pressure_solve.pressure();
+            // Into the particles: P (without tension where the fluid has a free surface), roles.
             fill(&mut p.pressure[..nf], |i| cavitation(clip, solved[i]));
             fill(&mut p.free_surface[..nf], |i| surface.roles[i].code());
             laps.lap(pressure_solve::NAME);
             let velocity =
                 self.corrector
                     .run(&nb, p, set, &self.faces, &surface, interfaces, u_star, dt);
+            // Into the particles: uⁿ⁺¹.
             copy_vector(velocity, &mut p.vel);
             let grad_p = &*u_star;
             laps.lap(corrector::NAME);
@@ -314,6 +317,7 @@ impl<const D: usize> Step<D> {
                     normal: &p.normal,
                     gravity: set.ghost_gravity(),
                 };
+                // Into the particles: the walls' P, for the frame.
                 self.wall_pressure.run(&nb, &ghosts, &mut p.pressure, nf);
                 laps.lap(wall_pressure::NAME);
             }
@@ -330,6 +334,7 @@ impl<const D: usize> Step<D> {
                         velocity,
                         dt,
                     );
+                    // Into the particles: u and P at the shifted positions.
                     copy_vector(velocity, &mut p.vel);
                     shifting::carry_pressure(&mut p.pressure[..nf], grad_p, shift, clip);
                     laps.lap(shifting::NAME);
@@ -339,6 +344,7 @@ impl<const D: usize> Step<D> {
             };
             (solve, density_error, disorder, shift)
         };
+        // Into the particles: r (and u where the contact puts a particle back).
         let penetrations = self
             .advection
             .run(p, nf, dt, shift, &self.faces, set.spacing);

@@ -73,7 +73,8 @@ impl<const D: usize> Shifting<D> {
             // Where the free surface is in reach the velocity gradient is no longer that of a
             // filled support, and shifting moves particles into the thinning, faster parts of a
             // stretching flow: the Taylor step there feeds the flow energy
-            // (docs/stabilisation.md).
+            // (docs/stabilisation.md, "Near the free surface only: the divergence correction
+            // and the Taylor step").
             if !full[i] {
                 return p.velocity(i);
             }

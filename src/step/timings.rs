@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 /// Accumulated time and number of runs per stage, in the order the stages were listed.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Timings {
     stages: Vec<StageTime>,
 }
@@ -30,18 +30,11 @@ impl Timings {
         Self { stages }
     }
 
-    fn entry(&mut self, stage: &'static str) -> &mut StageTime {
-        match self.stages.iter().position(|s| s.name == stage) {
-            Some(k) => &mut self.stages[k],
-            None => {
-                self.stages.push(StageTime {
-                    name: stage,
-                    spent: Duration::ZERO,
-                    runs: 0,
-                });
-                self.stages.last_mut().expect("just pushed")
-            }
-        }
+    fn entry(&mut self, stage: &str) -> &mut StageTime {
+        self.stages
+            .iter_mut()
+            .find(|s| s.name == stage)
+            .expect("a stage of the step (`Timings::new`)")
     }
 
     /// Counts one run of `stage` that took `d`.

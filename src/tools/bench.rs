@@ -1,12 +1,14 @@
 //! `isph bench`: the 3D dam break of `scenes/dam_break_3d.toml` timed at several particle
-//! counts and thread counts (issue 4).
+//! counts and thread counts.
 //!
 //! Each (size, threads) point runs in a child process of its own (the hidden `--child` form of
-//! `isph bench`, see [`crate::tools::child`]), so that the peak resident memory it reports (VmHWM) is
-//! that point's alone and its thread pool has exactly the requested size. The child builds the scene, takes warm-up
-//! steps, times the steps that follow through the public `Simulation` API, then times the PPE
-//! operator's apply on the state reached (see [`PpeSetup`]) and prints a [`Measurement`] as TOML
-//! on stdout; the parent collects the points, prints a table and writes the CSV.
+//! `isph bench`, see [`crate::tools::child`]), so that the peak resident memory it reports
+//! (VmHWM) is that point's alone and its thread pool has exactly the requested size. The child
+//! builds the scene, takes warm-up steps, times the steps that follow and the time of each
+//! stage (`Simulation::timings`), then times the apply of the PPE operator the step's own
+//! stages build on the state reached (`Simulation::probe_pressure_operator`), and prints a
+//! [`Measurement`] as TOML on stdout; the parent collects the points, prints a table and writes
+//! the CSV.
 
 use crate::math::reduce::in_pool;
 use crate::particles::Kind;

@@ -10,7 +10,7 @@ use std::fmt;
 /// One stage of the time step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlannedStage {
-    /// The stage's name (`step::Stage::name`).
+    /// The stage's name (its line in `isph plan`, its timing).
     pub stage: &'static str,
     /// What it computes, with the scene's constants.
     pub what: String,

@@ -1,9 +1,9 @@
 //! `isph study STUDY.toml`: accuracy against cost over a grid of settings (docs/study-format.md).
 //!
-//! Each point of the grid is the study's scene with the point's settings written in
-//! (`overrides`), run by a child `isph run` (so its wall time and peak memory are its own, see
-//! [`crate::tools::child`]), measured by [`crate::tools::validation::measure`] and recorded as one row of
-//! `OUT/study.csv` (`table`). A point with a row is never run again, and `claim` keeps two
+//! Each point of the grid is the study's scene with the point's settings written in (`overrides`),
+//! run by a child `isph run` (so its wall time and peak memory are its own, see
+//! [`crate::tools::child`]), measured by [`crate::tools::validation::measure`] and recorded as one
+//! row of `OUT/study.csv` (`table`). A point with a row is never run again, and `claim` keeps two
 //! processes on the same OUT from running the same point. Once every point has its row,
 //! `OUT/study.svg` plots error against wall time with the Pareto front (`plot`).
 

@@ -5,9 +5,9 @@
 //! front Z = x/a, x the largest distance from the back wall of a fluid particle that is not
 //! spray (`Role::Splash`: too isolated to carry a pressure gradient). Once the surge has thinned
 //! to a layer a particle or two thick, single particles slide off its tip one behind the other,
-//! up to 18 spacings ahead of the water at a/20 (T = 9.2); the experiment's front is that of
-//! the water body, and counting the loose particles made the error jump between 6.6% and 9.1%
-//! with a change of the tank's length by 2 cm. The error is
+//! well ahead of the water; the experiment's front is that of the water body, and counted,
+//! the loose particles make the error jump with small changes of the tank's length
+//! (docs/accuracy.md, "Dam break (2D): the surge front against Martin & Moyce"). The error is
 //! the mean relative error |Z − Z_ref| / Z_ref over the tabulated points whose time the run
 //! reached, each against the frame nearest its time; points whose front lies beyond 90% of the
 //! way to the far wall are left out (the wall stops the surge there). Details: the largest of

@@ -1,0 +1,111 @@
+//! The scene file as TOML sections (serde), unknown keys rejected; `validate` turns it into a
+//! `Scene`.
+
+use super::{Fluid, SolverSettings, WallSettings};
+use serde::Deserialize;
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SceneFile {
+    pub(super) simulation: SimulationSection,
+    #[serde(default)]
+    pub(super) fluid: Vec<Fluid>,
+    #[serde(default)]
+    pub(super) fluid_block: Vec<FluidBlock>,
+    pub(super) container: ContainerSection,
+    #[serde(default)]
+    pub(super) obstacle: Vec<BoxSection>,
+    pub(super) initial_velocity: Option<InitialVelocitySection>,
+    #[serde(default)]
+    pub(super) solver: SolverSettings,
+    #[serde(default)]
+    pub(super) checkpoint: CheckpointSection,
+    #[serde(default)]
+    pub(super) effects: EffectsSection,
+    #[serde(default)]
+    pub(super) walls: WallSettings,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SimulationSection {
+    pub(super) name: Option<String>,
+    pub(super) dimensions: i64,
+    pub(super) spacing: f64,
+    pub(super) end_time: f64,
+    pub(super) output_interval: f64,
+    pub(super) gravity: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FluidBlock {
+    pub(super) fluid: String,
+    pub(super) min: Vec<f64>,
+    pub(super) max: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct BoxSection {
+    pub(super) min: Vec<f64>,
+    pub(super) max: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ContainerSection {
+    pub(super) min: Vec<f64>,
+    pub(super) max: Vec<f64>,
+    pub(super) periodic: Option<Vec<bool>>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct InitialVelocitySection {
+    pub(super) field: String,
+    pub(super) amplitude: f64,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct CheckpointSection {
+    pub(super) interval: Option<f64>,
+    pub(super) wall_interval: Option<f64>,
+    pub(super) keep: Option<i64>,
+}
+
+/// The `[effects]` section as written: each effect a sub-table, every key optional.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct EffectsSection {
+    #[serde(default)]
+    pub(super) shifting: ShiftingSection,
+    #[serde(default)]
+    pub(super) les: LesSection,
+    #[serde(default)]
+    pub(super) kernel_correction: KernelCorrectionSection,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ShiftingSection {
+    pub(super) enabled: Option<bool>,
+    pub(super) coefficient: Option<f64>,
+    pub(super) max_shift: Option<f64>,
+    pub(super) clustering_weight: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LesSection {
+    pub(super) enabled: Option<bool>,
+    pub(super) cs: Option<f64>,
+    pub(super) wall_function: Option<bool>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct KernelCorrectionSection {
+    pub(super) enabled: Option<bool>,
+}

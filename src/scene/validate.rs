@@ -1,0 +1,537 @@
+//! Checks a parsed scene file and turns it into a `Scene`: every error names the file, the
+//! key and, where it can be found, the line.
+
+use super::file::{
+    BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection, SceneFile,
+    ShiftingSection,
+};
+use super::{
+    Aabb, Block, CheckpointSettings, Effects, InitialVelocity, LesSettings, Scene, SceneError,
+    ShiftingSettings, SolverSettings,
+};
+use crate::math::kernel::SUPPORT_IN_H;
+use std::path::Path;
+
+/// Frames a scene may ask for, at most (end_time / output_interval).
+const MAX_FRAMES: f64 = 1e5;
+
+/// Peak resident memory of a run per particle, walls included, with a margin over the peaks
+/// `isph bench` measures on the 3D dam break from 10⁴ to 10⁶ particles (docs/performance.md,
+/// "Memory per particle").
+const PEAK_BYTES_PER_PARTICLE: f64 = 600.0;
+
+/// Checks a parsed file and turns it into a `Scene`, locating bad keys in the source text.
+pub(super) struct Validator<'a> {
+    pub(super) text: &'a str,
+    pub(super) path: &'a Path,
+}
+
+impl Validator<'_> {
+    fn error(&self, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            path: self.path.to_owned(),
+            line: line_of_key(self.text, key),
+            key: key.to_owned(),
+            message: message.into(),
+        }
+    }
+
+    fn check(&self, ok: bool, key: &str, message: impl Into<String>) -> Result<(), SceneError> {
+        if ok {
+            Ok(())
+        } else {
+            Err(self.error(key, message))
+        }
+    }
+
+    fn positive(&self, value: f64, key: &str, unit: &str) -> Result<(), SceneError> {
+        self.check(
+            value.is_finite() && value > 0.0,
+            key,
+            format!("= {value:?} must be a positive number [{unit}]"),
+        )
+    }
+
+    fn vector(&self, v: &[f64], dims: usize, key: &str) -> Result<(), SceneError> {
+        self.check(
+            v.len() == dims,
+            key,
+            format!(
+                "has {} components but the scene has `simulation.dimensions = {dims}`",
+                v.len()
+            ),
+        )?;
+        self.check(
+            v.iter().all(|x| x.is_finite()),
+            key,
+            "must hold finite numbers",
+        )
+    }
+
+    fn aabb(
+        &self,
+        b: &BoxSection,
+        dims: usize,
+        key: &str,
+        spacing: f64,
+    ) -> Result<Aabb, SceneError> {
+        self.vector(&b.min, dims, &format!("{key}.min"))?;
+        self.vector(&b.max, dims, &format!("{key}.max"))?;
+        for d in 0..dims {
+            self.check(
+                // (0.21 − 0.2 = 0.00999… is one spacing of 0.01)
+                b.max[d] - b.min[d] >= spacing * (1.0 - 1e-9),
+                &format!("{key}.max"),
+                format!(
+                    "must exceed `{key}.min` by at least one particle spacing ({spacing:?} m) in every axis; axis {d} has {:?} .. {:?}",
+                    b.min[d], b.max[d]
+                ),
+            )?;
+        }
+        Ok(Aabb {
+            min: b.min.clone(),
+            max: b.max.clone(),
+        })
+    }
+
+    /// A box section that must lie inside the container.
+    fn region_inside(
+        &self,
+        b: &BoxSection,
+        container: &Aabb,
+        dims: usize,
+        key: &str,
+        spacing: f64,
+        what: &str,
+    ) -> Result<Aabb, SceneError> {
+        let region = self.aabb(b, dims, key, spacing)?;
+        self.check(
+            region.within(container),
+            &format!("{key}.min"),
+            format!(
+                "the {what} {:?} .. {:?} is not inside the container {:?} .. {:?}",
+                region.min, region.max, container.min, container.max
+            ),
+        )?;
+        Ok(region)
+    }
+
+    pub(super) fn scene(&self, f: SceneFile) -> Result<Scene, SceneError> {
+        let s = &f.simulation;
+        self.check(
+            s.dimensions == 2 || s.dimensions == 3,
+            "simulation.dimensions",
+            format!("= {} is not supported: use 2 or 3", s.dimensions),
+        )?;
+        let dims = s.dimensions as usize;
+        self.positive(s.spacing, "simulation.spacing", "m")?;
+        self.positive(s.end_time, "simulation.end_time", "s")?;
+        self.positive(s.output_interval, "simulation.output_interval", "s")?;
+        let frames = s.end_time / s.output_interval;
+        self.check(
+            frames <= MAX_FRAMES,
+            "simulation.output_interval",
+            format!(
+                "= {:?} makes {frames:.3e} frames to end_time = {:?} s; at most {MAX_FRAMES} (each frame holds every particle)",
+                s.output_interval, s.end_time
+            ),
+        )?;
+        self.vector(&s.gravity, dims, "simulation.gravity")?;
+
+        self.check(
+            !f.fluid.is_empty(),
+            "fluid",
+            "is missing: define at least one [[fluid]]",
+        )?;
+        for (k, fl) in f.fluid.iter().enumerate() {
+            let key = format!("fluid[{k}]");
+            self.positive(fl.density, &format!("{key}.density"), "kg/m^3")?;
+            self.check(
+                fl.viscosity.is_finite() && fl.viscosity >= 0.0,
+                &format!("{key}.viscosity"),
+                format!("= {:?} must be a non-negative number [m^2/s]", fl.viscosity),
+            )?;
+            self.check(
+                f.fluid[..k].iter().all(|o| o.name != fl.name),
+                &format!("{key}.name"),
+                format!("= \"{}\" is defined twice", fl.name),
+            )?;
+        }
+
+        let container_box = BoxSection {
+            min: f.container.min.clone(),
+            max: f.container.max.clone(),
+        };
+        let container = self.aabb(&container_box, dims, "container", s.spacing)?;
+        let periodic = self.periodic(
+            f.container.periodic.as_deref(),
+            &container,
+            s.spacing,
+            &f.solver,
+        )?;
+        self.check(
+            !f.fluid_block.is_empty(),
+            "fluid_block",
+            "is missing: define at least one [[fluid_block]]",
+        )?;
+        let mut blocks = Vec::new();
+        for (k, b) in f.fluid_block.iter().enumerate() {
+            let key = format!("fluid_block[{k}]");
+            let fluid = f
+                .fluid
+                .iter()
+                .position(|fl| fl.name == b.fluid)
+                .ok_or_else(|| {
+                    let names: Vec<_> = f
+                        .fluid
+                        .iter()
+                        .map(|fl| format!("\"{}\"", fl.name))
+                        .collect();
+                    self.error(
+                        &format!("{key}.fluid"),
+                        format!(
+                            "= \"{}\" names no [[fluid]]; defined fluids: {}",
+                            b.fluid,
+                            names.join(", ")
+                        ),
+                    )
+                })?;
+            let section = BoxSection {
+                min: b.min.clone(),
+                max: b.max.clone(),
+            };
+            let region =
+                self.region_inside(&section, &container, dims, &key, s.spacing, "block")?;
+            blocks.push(Block { fluid, region });
+        }
+        let mut obstacles = Vec::new();
+        for (k, o) in f.obstacle.iter().enumerate() {
+            let key = format!("obstacle[{k}]");
+            let region = self.region_inside(o, &container, dims, &key, s.spacing, "obstacle")?;
+            obstacles.push(region);
+        }
+
+        let sv = &f.solver;
+        self.check(
+            sv.tolerance > 0.0 && sv.tolerance < 1.0,
+            "solver.tolerance",
+            format!("= {:?} must lie in (0, 1)", sv.tolerance),
+        )?;
+        self.check(
+            sv.max_iterations >= 1,
+            "solver.max_iterations",
+            "must be at least 1",
+        )?;
+        self.check(
+            (0.0..=1.0).contains(&sv.alpha),
+            "solver.alpha",
+            format!(
+                "= {:?} must lie in [0, 1] (0: divergence-free only, 1: density-invariant only)",
+                sv.alpha
+            ),
+        )?;
+        self.check(
+            sv.cfl > 0.0 && sv.cfl <= 1.0,
+            "solver.cfl",
+            format!("= {:?} must lie in (0, 1]", sv.cfl),
+        )?;
+        self.check(
+            (1.0..=2.0).contains(&sv.h_over_dx),
+            "solver.h_over_dx",
+            format!("= {:?} must lie in [1, 2]", sv.h_over_dx),
+        )?;
+
+        let initial_velocity = f
+            .initial_velocity
+            .as_ref()
+            .map(|v| self.initial_velocity(v, &container, &periodic))
+            .transpose()?;
+        let checkpoint = self.checkpoint(&f.checkpoint)?;
+        let effects = self.effects(&f.effects)?;
+
+        let name = match &s.name {
+            Some(n) => {
+                // The run goes to out/<name>: one plain directory name, not a path.
+                let plain = !n.is_empty()
+                    && n != "."
+                    && n != ".."
+                    && !n.contains(['/', '\\'])
+                    && n.trim() == n;
+                self.check(
+                    plain,
+                    "simulation.name",
+                    format!("= \"{n}\" must be a plain directory name (the run goes to out/<name>): not empty, no '/', not \".\" or \"..\", no surrounding spaces"),
+                )?;
+                n.clone()
+            }
+            None => self
+                .path
+                .file_stem()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene".into()),
+        };
+        let scene = Scene {
+            path: self.path.to_owned(),
+            name,
+            dimensions: dims,
+            spacing: s.spacing,
+            end_time: s.end_time,
+            output_interval: s.output_interval,
+            gravity: s.gravity.clone(),
+            fluids: f.fluid,
+            blocks,
+            container,
+            periodic,
+            obstacles,
+            initial_velocity,
+            solver: f.solver,
+            checkpoint,
+            effects,
+            walls: f.walls,
+        };
+        self.fits_in_memory(&scene)?;
+        Ok(scene)
+    }
+
+    /// Refuses a scene whose particles could not be held: more than the u32 indices of the
+    /// cell sort reach, or more memory at the peak of a run (`PEAK_BYTES_PER_PARTICLE`) than
+    /// the machine has in all (not what is free now: a study measures its finished points while
+    /// others run).
+    fn fits_in_memory(&self, scene: &Scene) -> Result<(), SceneError> {
+        let particles = scene.particle_bound();
+        let key = "simulation.spacing";
+        let what = format!(
+            "= {:?} puts up to {particles:.3e} particles in the container and its walls",
+            scene.spacing
+        );
+        self.check(
+            particles < u32::MAX as f64,
+            key,
+            format!("{what}, more than the {} isph can index", u32::MAX),
+        )?;
+        let needed = particles * PEAK_BYTES_PER_PARTICLE;
+        // The machine's memory in all (MemTotal); no check where /proc/meminfo cannot be read.
+        if let Ok(memory) = crate::math::memory::proc_bytes("/proc/meminfo", "MemTotal") {
+            let memory = memory as f64;
+            const GIB: f64 = (1u64 << 30) as f64;
+            self.check(
+                needed <= memory,
+                key,
+                format!(
+                    "{what}: about {:.1} GiB at {PEAK_BYTES_PER_PARTICLE} B/particle, more than the {:.1} GiB of memory this machine has",
+                    needed / GIB,
+                    memory / GIB
+                ),
+            )?;
+        }
+        Ok(())
+    }
+
+    /// `container.periodic`: one flag per axis. A periodic axis must hold a whole number of
+    /// particle spacings (the lattice must close on itself) and at least three kernel supports
+    /// (so that a particle never meets two images of another).
+    fn periodic(
+        &self,
+        flags: Option<&[bool]>,
+        container: &Aabb,
+        spacing: f64,
+        solver: &SolverSettings,
+    ) -> Result<Vec<bool>, SceneError> {
+        let dims = container.min.len();
+        let Some(flags) = flags else {
+            return Ok(vec![false; dims]);
+        };
+        let key = "container.periodic";
+        self.check(
+            flags.len() == dims,
+            key,
+            format!(
+                "has {} flags but the scene has `simulation.dimensions = {dims}`",
+                flags.len()
+            ),
+        )?;
+        let support = SUPPORT_IN_H * solver.h_over_dx * spacing;
+        for d in (0..dims).filter(|&d| flags[d]) {
+            let length = container.max[d] - container.min[d];
+            let spacings = length / spacing;
+            self.check(
+                (spacings - spacings.round()).abs() < 1e-6 * spacings,
+                key,
+                format!("axis {d} is periodic, so its length {length:?} m must be a whole number of spacings ({spacing:?} m); it is {spacings:.4} spacings"),
+            )?;
+            self.check(
+                length >= 3.0 * support,
+                key,
+                format!("axis {d} is periodic, so its length {length:?} m must be at least three kernel supports (3 × 3h = {:.4} m)", 3.0 * support),
+            )?;
+        }
+        Ok(flags.to_vec())
+    }
+
+    /// `[initial_velocity]`: a named analytic field and its amplitude.
+    fn initial_velocity(
+        &self,
+        v: &InitialVelocitySection,
+        container: &Aabb,
+        periodic: &[bool],
+    ) -> Result<InitialVelocity, SceneError> {
+        self.check(
+            v.field == "taylor_green",
+            "initial_velocity.field",
+            format!(
+                "= \"{}\" is not a known field; known: \"taylor_green\"",
+                v.field
+            ),
+        )?;
+        let lengths: Vec<f64> = (0..container.min.len())
+            .map(|d| container.max[d] - container.min[d])
+            .collect();
+        self.check(
+            lengths.len() == 2
+                && periodic.iter().all(|&p| p)
+                && (lengths[0] - lengths[1]).abs() <= 1e-9 * lengths[0],
+            "initial_velocity.field",
+            "= \"taylor_green\" needs a 2D container periodic in both axes (`container.periodic = [true, true]`) and square",
+        )?;
+        self.check(
+            v.amplitude.is_finite(),
+            "initial_velocity.amplitude",
+            format!("= {:?} must be a finite number [m/s]", v.amplitude),
+        )?;
+        Ok(InitialVelocity::TaylorGreen {
+            amplitude: v.amplitude,
+        })
+    }
+
+    fn effects(&self, e: &EffectsSection) -> Result<Effects, SceneError> {
+        Ok(Effects {
+            shifting: self.shifting(&e.shifting)?,
+            les: self.les(&e.les)?,
+            kernel_correction: e.kernel_correction.enabled.unwrap_or(true),
+        })
+    }
+
+    /// Whether effect `name` is on (`enabled`, default true); an effect turned off must not be
+    /// given parameters, which it would silently ignore: `given` lists them (key, present).
+    fn enabled(
+        &self,
+        name: &str,
+        enabled: Option<bool>,
+        given: &[(&str, bool)],
+    ) -> Result<bool, SceneError> {
+        let on = enabled.unwrap_or(true);
+        if !on {
+            if let Some((key, _)) = given.iter().find(|(_, present)| *present) {
+                return Err(self.error(
+                    &format!("effects.{name}.{key}"),
+                    format!("is given but `effects.{name}.enabled = false` turns the effect off: remove the key or the `enabled = false`"),
+                ));
+            }
+        }
+        Ok(on)
+    }
+
+    fn shifting(&self, s: &ShiftingSection) -> Result<Option<ShiftingSettings>, SceneError> {
+        let given = [
+            ("coefficient", s.coefficient.is_some()),
+            ("max_shift", s.max_shift.is_some()),
+            ("clustering_weight", s.clustering_weight.is_some()),
+        ];
+        if !self.enabled("shifting", s.enabled, &given)? {
+            return Ok(None);
+        }
+        let default = ShiftingSettings::default();
+        let settings = ShiftingSettings {
+            coefficient: s.coefficient.unwrap_or(default.coefficient),
+            max_shift: s.max_shift.unwrap_or(default.max_shift),
+            clustering_weight: s.clustering_weight.unwrap_or(default.clustering_weight),
+        };
+        self.check(
+            settings.coefficient.is_finite() && settings.coefficient > 0.0,
+            "effects.shifting.coefficient",
+            format!(
+                "= {:?} must be a positive number (A of D = A h U Δt)",
+                settings.coefficient
+            ),
+        )?;
+        self.check(
+            settings.max_shift > 0.0 && settings.max_shift <= 1.0,
+            "effects.shifting.max_shift",
+            format!(
+                "= {:?} must lie in (0, 1] [particle spacings]",
+                settings.max_shift
+            ),
+        )?;
+        self.check(
+            settings.clustering_weight.is_finite() && settings.clustering_weight >= 0.0,
+            "effects.shifting.clustering_weight",
+            format!(
+                "= {:?} must be a non-negative number",
+                settings.clustering_weight
+            ),
+        )?;
+        Ok(Some(settings))
+    }
+
+    fn les(&self, l: &LesSection) -> Result<Option<LesSettings>, SceneError> {
+        let given = [
+            ("cs", l.cs.is_some()),
+            ("wall_function", l.wall_function.is_some()),
+        ];
+        if !self.enabled("les", l.enabled, &given)? {
+            return Ok(None);
+        }
+        let default = LesSettings::default();
+        let settings = LesSettings {
+            cs: l.cs.unwrap_or(default.cs),
+            wall_function: l.wall_function.unwrap_or(default.wall_function),
+        };
+        self.check(
+            settings.cs > 0.0 && settings.cs <= 1.0,
+            "effects.les.cs",
+            format!(
+                "= {:?} must lie in (0, 1] (to turn LES off, set `effects.les.enabled = false`)",
+                settings.cs
+            ),
+        )?;
+        Ok(Some(settings))
+    }
+
+    fn checkpoint(&self, c: &CheckpointSection) -> Result<CheckpointSettings, SceneError> {
+        let default = CheckpointSettings::default();
+        if let Some(interval) = c.interval {
+            self.positive(interval, "checkpoint.interval", "s")?;
+        }
+        let wall_interval = c.wall_interval.unwrap_or(default.wall_interval);
+        self.positive(wall_interval, "checkpoint.wall_interval", "s")?;
+        let keep = c.keep.unwrap_or(default.keep as i64);
+        self.check(
+            keep >= 1,
+            "checkpoint.keep",
+            format!("= {keep} must be at least 1 (the newest checkpoint is always kept)"),
+        )?;
+        Ok(CheckpointSettings {
+            interval: c.interval,
+            wall_interval,
+            keep: keep as usize,
+        })
+    }
+}
+
+/// 1-based line of a dotted key such as `fluid_block[1].fluid` in TOML source, if present.
+fn line_of_key(text: &str, key: &str) -> Option<usize> {
+    let doc = toml_edit::ImDocument::parse(text).ok()?;
+    let mut item = doc.as_item();
+    for part in key.split('.') {
+        let (name, index) = match part.split_once('[') {
+            Some((n, rest)) => (n, rest.trim_end_matches(']').parse::<usize>().ok()),
+            None => (part, None),
+        };
+        item = item.get(name)?;
+        if let Some(k) = index {
+            item = item.get(k)?;
+        }
+    }
+    let span = item.span()?;
+    Some(text[..span.start].matches('\n').count() + 1)
+}
