@@ -301,3 +301,30 @@ fn a_run_of_more_than_ten_million_steps_is_warned_of_with_the_limit_that_sets_th
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains("warning"), "{stderr}");
 }
+
+#[test]
+fn the_progress_line_shows_the_end_time_as_written() {
+    let dir = TempDir::new("progress-end");
+    // Frames every 0.1 s: the run ends on the third, scheduled at 3 × 0.1 = 0.30000000000000004.
+    let text = good().replace("output_interval = 0.01", "output_interval = 0.1");
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("out");
+    let o = isph(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--until",
+        "0.3",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    // Not a terminal: plain lines, the first after the first step.
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("t = "))
+        .unwrap_or_else(|| panic!("{stderr}"));
+    assert!(line.contains("/0.3 s |"), "{line}");
+    assert!(!stderr.contains("0.30000000000000004"), "{stderr}");
+}

@@ -21,6 +21,9 @@ pub enum Progress {
         last: Instant,
         last_step: u64,
         start_time: f64,
+        /// Whether a line has been printed: the first comes after the first step, so that a
+        /// batch log shows at once where the run is going.
+        printed: bool,
     },
     Quiet,
 }
@@ -51,6 +54,7 @@ impl Progress {
                 last: now,
                 last_step: start_step,
                 start_time,
+                printed: false,
             }
         }
     }
@@ -78,15 +82,16 @@ impl Progress {
                 last,
                 last_step,
                 start_time,
+                printed,
             } => {
-                if now.duration_since(*last) >= LINE_INTERVAL {
+                if !*printed || now.duration_since(*last) >= LINE_INTERVAL {
                     let rate =
                         (s.step - *last_step) as f64 / now.duration_since(*last).as_secs_f64();
                     let wall = now.duration_since(*start).as_secs_f64();
                     let done = (s.time - *start_time) / (*end - *start_time);
                     let eta = wall * (1.0 - done) / done.max(1e-12);
                     eprintln!("{} | ETA {:.0} s", message(s, *end, rate), eta);
-                    (*last, *last_step) = (now, s.step);
+                    (*last, *last_step, *printed) = (now, s.step, true);
                 }
             }
             Progress::Quiet => {}
