@@ -6,7 +6,7 @@
 //!
 //! The layers, lowest first (a module imports only from its own folder and the layers before
 //! it; `tests/layering.rs` holds this): [`math`], [`scene`], [`particles`], [`neighbours`],
-//! [`boundary`], [`sph`], [`solver`], `effects`, [`fill`], `step`, [`simulation`], [`io`],
+//! [`boundary`], [`sph`], [`solver`], `effects`, [`fill`], [`io`], `step`, [`simulation`],
 //! [`run`], [`tools`].
 
 // Axis and tensor loops index several arrays by the same d (or a, b), as the equations do.

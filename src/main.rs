@@ -358,7 +358,7 @@ fn start_threads(threads: Option<usize>) -> anyhow::Result<()> {
 fn check_until(until: Option<f64>) -> anyhow::Result<()> {
     if let Some(t) = until {
         if !(t.is_finite() && t > 0.0) {
-            bail!("--until {t}: the stop time must be a positive number of seconds");
+            bail!("--until {t:?}: the stop time must be a positive number of seconds");
         }
     }
     Ok(())

@@ -140,9 +140,39 @@ impl<const D: usize> Simulation<D> {
     /// Advances by one step towards the simulated time `target` (the next frame's), landing on
     /// it exactly when it is within reach (`Step::advance`).
     pub fn advance_towards(&mut self, target: f64) -> Result<StepStats, NumericalFailure> {
-        let report =
-            self.stepper
-                .advance(&mut self.particles, self.time, target, &mut self.timings);
+        self.advance(target, None)
+    }
+
+    /// `advance_towards`, handing `probe` the PPE operator of the step before its solve: the
+    /// operator the step's own stages build (`isph bench` times its apply).
+    pub fn advance_probing<R>(
+        &mut self,
+        target: f64,
+        probe: impl FnOnce(&PressureOperator<D>) -> R,
+    ) -> Result<(StepStats, R), NumericalFailure> {
+        let mut probe = Some(probe);
+        let mut probed = None;
+        let mut hook = |op: &PressureOperator<D>| {
+            if let Some(probe) = probe.take() {
+                probed = Some(probe(op));
+            }
+        };
+        let stats = self.advance(target, Some(&mut hook))?;
+        Ok((stats, probed.expect("every step solves the PPE")))
+    }
+
+    fn advance(
+        &mut self,
+        target: f64,
+        probe: Option<&mut dyn FnMut(&PressureOperator<D>)>,
+    ) -> Result<StepStats, NumericalFailure> {
+        let report = self.stepper.advance(
+            &mut self.particles,
+            self.time,
+            target,
+            &mut self.timings,
+            probe,
+        );
         let report = report.map_err(|e| self.failure(e))?;
         self.time = if report.lands_on_target {
             target
@@ -164,18 +194,6 @@ impl<const D: usize> Simulation<D> {
         })
     }
 
-    /// Sorts the particles and hands `probe` the PPE operator of their state
-    /// (`Step::probe_pressure_operator`).
-    pub fn probe_pressure_operator<R>(
-        &mut self,
-        probe: impl FnOnce(&PressureOperator<D>) -> R,
-    ) -> Result<R, NumericalFailure> {
-        let probed = self
-            .stepper
-            .probe_pressure_operator(&mut self.particles, probe);
-        probed.map_err(|e| self.failure(e))
-    }
-
     /// The failure of a step, at this step and time.
     fn failure(&self, e: StepError) -> NumericalFailure {
         let (step, time) = (self.step, self.time);
@@ -193,7 +211,7 @@ impl<const D: usize> Simulation<D> {
                 max_speed,
             },
             StepError::Solver(source) => NumericalFailure::Solver { step, time, source },
-            StepError::NonFinite => NumericalFailure::NonFinite {
+            StepError::NonFinite { time } => NumericalFailure::NonFinite {
                 step: step + 1,
                 time,
             },

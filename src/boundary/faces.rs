@@ -1,5 +1,5 @@
 //! The faces of the walls: the container's box (but along its periodic axes) and the obstacles'
-//! boxes, the geometry the dummy wall particles of `wall` stand for. From it each wall particle
+//! boxes, the geometry the dummy wall particles of `ghosts` stand for. From it each wall particle
 //! takes its normal, and each fluid particle the kinematic wall condition: no velocity into a
 //! face it touches (`no_penetration`), and at the end of a step the hard contact that puts back
 //! a particle that crossed one (`contact`).
@@ -177,4 +177,13 @@ impl Faces {
             low.into_iter().chain(high)
         })
     }
+}
+
+/// Distance from a wall face within which a fluid particle touches it (the kinematic condition
+/// of `Faces::no_penetration`): half a spacing, the distance at which the fluid's first layer
+/// rests, and a hair more so that the resting layer is included (the still tank and the
+/// violent impact at other distances: docs/stabilisation.md, "The kinematic wall condition and
+/// wall crossings").
+pub fn touching_distance(spacing: f64) -> f64 {
+    0.5001 * spacing
 }

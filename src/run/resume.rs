@@ -58,7 +58,7 @@ pub enum ResumeError {
         now: usize,
         then: usize,
     },
-    #[error("{checkpoint} is already at t = {time} s, not before the stop time {end} s; pass --until with a later time (or raise `end_time` in the scene)")]
+    #[error("{checkpoint} is already at t = {time:?} s, not before the stop time {end:?} s; pass --until with a later time (or raise `end_time` in the scene)")]
     NothingToDo {
         checkpoint: PathBuf,
         time: f64,

@@ -55,6 +55,10 @@ impl<const D: usize> Stage<D> for CellSort<D> {
         "counting sort by cell (x fastest), every particle array permuted together; the runs of cells around each fluid particle, which every pair loop of the step reads instead of searching the grid (about 20 runs of 6 B per fluid particle in 3D, not in the figure)".into()
     }
 
+    fn fluid_only(&self) -> bool {
+        false
+    }
+
     fn arrays(&self) -> Vec<ArraySize> {
         let sort = [
             ArraySize::of("cell of particle", &self.cell_of),

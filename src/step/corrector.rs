@@ -4,7 +4,7 @@
 
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
-use crate::boundary::faces::Faces;
+use crate::boundary::faces::{self, Faces};
 use crate::boundary::ghosts;
 use crate::math::lanes::F64s;
 use crate::math::memory::ArraySize;
@@ -48,12 +48,10 @@ impl<const D: usize> Corrector<D> {
             a.resize(n, 0.0);
         }
         let corrections = surface.pressure_corrections;
-        let touch = touching_distance(set.spacing);
+        let touch = faces::touching_distance(set.spacing);
         let (roles, full) = (surface.roles, surface.full_support);
         let ghost = set.ghost_gravity();
-        let particles = p;
         fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
-            let p = particles;
             let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
             let grad = pressure_gradient(nb, p, ghost, interfaces, corrections.of(i), p_ref, i);
             let rho0 = p.rest_density[i];
@@ -83,22 +81,6 @@ impl<const D: usize> Stage<D> for Corrector<D> {
 
     fn arrays(&self) -> Vec<ArraySize> {
         vec![ArraySize::of_components("velocity", &self.velocity)]
-    }
-}
-
-/// Distance from a wall face within which a fluid particle touches it (the kinematic condition
-/// of `Faces::no_penetration`): half a spacing, the distance at which the fluid's first layer
-/// rests, and a hair more so that the resting layer is included (the still tank and the
-/// violent impact at other distances: docs/stabilisation.md, "The kinematic wall condition and
-/// wall crossings").
-pub fn touching_distance(spacing: f64) -> f64 {
-    0.5001 * spacing
-}
-
-/// `to[d][..n] = from[d]` for each component, n the length of `from`.
-pub fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
-    for (f, t) in from.iter().zip(to) {
-        t[..f.len()].copy_from_slice(f);
     }
 }
 

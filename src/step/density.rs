@@ -1,4 +1,4 @@
-//! Summation density and, where the fluids differ in rest density
+//! Summation density and, where the fluids differ in rest density,
 //! each fluid particle's distance to the nearest interface (`interface_distance`).
 
 use super::interface_distance::InterfaceDistance;

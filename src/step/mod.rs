@@ -6,14 +6,18 @@
 //! array. `Step::stages` lists the stages that run, in order, for `isph plan` and the timings.
 //!
 //! The fluid particles come first in the sorted order (`cell_list`), and every stage's array
-//! holds the fluid particles only: the walls hold no unknown and need none. `Particles`, the
-//! lasting state, is written at named points only: the summation density (`density`), the
-//! pressures and PPE roles (`pressure_solve`), the new velocity (`corrector`), the walls'
-//! pressures on a frame (`wall_pressure`), the shifted velocity and pressure (`shifting`) and
-//! the positions (`advection`). `Step` itself is scratch, rebuilt on resume, never checkpointed.
+//! but the sort's holds the fluid particles only: the walls hold no unknown and need none.
+//! `Particles`, the lasting state, is written at named points only, each marked "Into the
+//! particles" in `advance`: the order of every array (the cell sort), the summation density
+//! (`density`), the pressures and PPE roles (`pressure_solve`), the new velocity (`corrector`),
+//! the walls' pressures on a frame (`wall_pressure`), the shifted velocity and pressure
+//! (`shifting`), the positions (`advection`, then wrapped into a periodic box). `Step` holds the
+//! scene's constants and the stages' scratch: it is built again from the scene on resume and
+//! never checkpointed.
 //!
-//! A new optional stage is its file here, its field in `Step` (built in `Step::new` from its
-//! scene settings), its call in `Step::advance` and its entry in `Step::stages`.
+//! A new optional stage is its file here, its `mod` line, its field in `Step` (built in
+//! `Step::new` from its scene settings), its call in `Step::advance` and its entry in
+//! `Step::stages`; its settings are a section of the scene (`scene::Effects`).
 
 mod advection;
 mod cell_list;
@@ -44,8 +48,6 @@ use crate::solver::krylov::{SolveInfo, SolverError, SolverParams};
 use crate::solver::ppe::PressureOperator;
 use crate::sph::interface::Interfaces;
 use crate::sph::Corrections;
-use corrector::copy_vector;
-use pressure_solve::cavitation;
 use std::time::Instant;
 use time_step::StepLength;
 use timings::Timings;
@@ -65,12 +67,12 @@ pub struct StepSettings<const D: usize> {
     /// The fluid fills a closed or periodic container (`fill::fills_container`): it has no
     /// free surface, and none is looked for.
     pub confined: bool,
-    /// ρ/ρ0 below which fluid is spray, for the scene's h/dx (`free_surface::spray_density`).
+    /// ρ/ρ0 below which fluid is spray, for the scene's h/dx (`sph::free_surface::spray_density`).
     pub spray_density: f64,
     /// det M_i at or below which the kernel gradient correction is not applied, for the
     /// scene's h/dx (`sph::min_correction_determinant`).
     pub min_correction_determinant: f64,
-    /// The time-step limits' constants (`time_step`).
+    /// The CFL number of the time-step limit (`time_step`).
     pub cfl: f64,
     /// The largest kinematic viscosity of the scene's fluids [m²/s].
     pub max_viscosity: f64,
@@ -101,8 +103,9 @@ pub struct StepReport {
     pub disorder: f64,
     /// Fluid particles the advection put beyond a wall face, before the contact put them back.
     pub penetrations: usize,
-    /// Largest fluid speed and kinetic energy after the step.
+    /// Largest fluid speed after the step.
     pub max_speed: f64,
+    /// Kinetic energy of the fluid after the step.
     pub kinetic_energy: f64,
 }
 
@@ -119,8 +122,10 @@ pub enum StepError {
         max_speed: f64,
     },
     Solver(SolverError),
-    /// The velocity became non-finite.
-    NonFinite,
+    /// The velocity became non-finite in the step that ended at `time`.
+    NonFinite {
+        time: f64,
+    },
 }
 
 /// A stage as `isph plan` and the timings see it.
@@ -132,6 +137,11 @@ pub trait Stage<const D: usize> {
     /// Its per-particle arrays, as they are now (allocated when it first runs).
     fn arrays(&self) -> Vec<ArraySize> {
         Vec::new()
+    }
+    /// Whether its arrays hold the fluid particles only (they come first in the sorted
+    /// order), not every particle.
+    fn fluid_only(&self) -> bool {
+        true
     }
 }
 
@@ -223,7 +233,7 @@ impl<const D: usize> Step<D> {
     pub fn arrays(&self) -> Vec<(&'static str, ArraySize)> {
         let mut arrays = Vec::new();
         for stage in self.stages() {
-            let fluid_only = stage.name() != self.cell_list.name();
+            let fluid_only = stage.fluid_only();
             arrays.extend(stage.arrays().into_iter().map(|a| {
                 let a = if fluid_only && a.holds == Holds::EveryParticle {
                     a.fluid()
@@ -239,13 +249,17 @@ impl<const D: usize> Step<D> {
     /// Sorts the particles by cell, then advances them by one step towards the simulated time
     /// `target` from `time` (`time_step::length`). The step that lands on the target also
     /// computes the wall particles' pressure for the frame: in a large tank most wall
-    /// particles are dry, and visiting them at every step would cost a fifth of the step.
+    /// particles are dry, and visiting them at every step costs a large part of a step
+    /// (docs/performance.md, "Walls no fluid touches").
+    /// `probe`, if any, is handed the PPE's operator before the solve (`isph bench` times its
+    /// apply); the step goes on as without it.
     pub fn advance(
         &mut self,
         p: &mut Particles<D>,
         time: f64,
         target: f64,
         timings: &mut Timings,
+        probe: Option<&mut dyn FnMut(&PressureOperator<D>)>,
     ) -> Result<StepReport, StepError> {
         let mut laps = Laps::new(timings);
         self.cell_list.run(p)?;
@@ -254,9 +268,13 @@ impl<const D: usize> Step<D> {
         let (length, lands_on_target) = time_step::length(limit, target - time);
         let set = &self.settings;
         let dt = length.dt;
-        let nf = self.grid().range_of(Kind::Fluid).end;
+        let fluid = self.grid().range_of(Kind::Fluid);
+        debug_assert_eq!(fluid.start, 0, "the fluid comes first in the sorted order");
+        let nf = fluid.end;
         let (solve, density_error, disorder, shift) = {
             let nb = Neighbours::new(self.cell_list.grid(), &p.pos, self.kernel);
+            // The time-step limit is in no stage (`isph bench`'s "other").
+            laps.skip();
             let density = self.density.run(&nb, p, nf);
             // Into the particles: ρ.
             p.density[..nf].copy_from_slice(density);
@@ -292,6 +310,7 @@ impl<const D: usize> Step<D> {
                     interfaces,
                     u_star,
                     length,
+                    probe,
                 )
                 .map_err(StepError::Solver)?;
             let surface = self.free_surface.output();
@@ -352,10 +371,12 @@ impl<const D: usize> Step<D> {
         // Along a periodic axis a particle leaves the period only in the advection: wrapped
         // back here, the frames and checkpoints hold every position inside the box.
         self.cell_list.grid().wrap(&mut p.pos);
+        laps.skip();
         let (max_speed, kinetic_energy) = diagnostics::motion(p);
         laps.lap(diagnostics::NAME);
         if !max_speed.is_finite() {
-            return Err(StepError::NonFinite);
+            let time = if lands_on_target { target } else { time + dt };
+            return Err(StepError::NonFinite { time });
         }
         Ok(StepReport {
             length,
@@ -367,28 +388,6 @@ impl<const D: usize> Step<D> {
             max_speed,
             kinetic_energy,
         })
-    }
-
-    /// Sorts the particles and runs the stages the PPE's operator is built from (density,
-    /// free surface), then hands `probe` that operator, as the pressure solve would solve with
-    /// it (`isph bench` times its apply). The particles are left sorted, with the summation
-    /// density of their positions; their pressures and velocities are untouched.
-    pub fn probe_pressure_operator<R>(
-        &mut self,
-        p: &mut Particles<D>,
-        probe: impl FnOnce(&PressureOperator<D>) -> R,
-    ) -> Result<R, StepError> {
-        self.cell_list.run(p)?;
-        let set = &self.settings;
-        let nf = self.grid().range_of(Kind::Fluid).end;
-        let nb = Neighbours::new(self.cell_list.grid(), &p.pos, self.kernel);
-        let density = self.density.run(&nb, p, nf);
-        p.density[..nf].copy_from_slice(density);
-        let interfaces = self.density.interfaces(&nb, p, &self.faces, nf);
-        self.free_surface.run(&nb, p, set, nf);
-        self.pressure_solve
-            .probe(&nb, p, set, &mut self.free_surface, interfaces, probe)
-            .map_err(StepError::Solver)
     }
 }
 
@@ -413,9 +412,33 @@ impl<'a> Laps<'a> {
         self.clock = now;
     }
 
+    /// Starts the next lap here: the time since the last is charged to no stage.
+    fn skip(&mut self) {
+        self.clock = Instant::now();
+    }
+
     fn part(&mut self, stage: &'static str) {
         let now = Instant::now();
         self.timings.add_part(stage, now - self.clock);
         self.clock = now;
+    }
+}
+
+/// The pressure the fluid takes: with a free surface the pressure is absolute (zero at the
+/// surface) and the water cannot hold a tension, so negative pressures are cut to zero; in a
+/// closed box (`clip` false) only differences count and P is kept as solved.
+#[inline]
+fn cavitation(clip: bool, pressure: f64) -> f64 {
+    if clip {
+        pressure.max(0.0)
+    } else {
+        pressure
+    }
+}
+
+/// `to[d][..n] = from[d]` for each component, n the length of `from`.
+fn copy_vector<const D: usize>(from: &[Vec<f64>; D], to: &mut [Vec<f64>; D]) {
+    for (f, t) in from.iter().zip(to) {
+        t[..f.len()].copy_from_slice(f);
     }
 }

@@ -53,7 +53,8 @@ impl<const D: usize> Default for PressureSolve<D> {
 
 impl<const D: usize> PressureSolve<D> {
     /// Solves for Pⁿ⁺¹ from u* (`u_star`) and the density error, with the roles of `surface`
-    /// (sealed regions are pinned there), the divergence corrected by `corrections`.
+    /// (sealed regions are pinned there), the divergence corrected by `corrections`; `probe`, if
+    /// any, is handed the operator first.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -65,6 +66,7 @@ impl<const D: usize> PressureSolve<D> {
         interfaces: Option<interface::Field<D>>,
         u_star: &[Vec<f64>; D],
         step: StepLength,
+        probe: Option<&mut dyn FnMut(&PressureOperator<D>)>,
     ) -> Result<SolveInfo, SolverError> {
         let nf = surface.full_support().len();
         let Self {
@@ -75,16 +77,18 @@ impl<const D: usize> PressureSolve<D> {
             multigrid,
         } = self;
         pressure.resize(nf, 0.0);
-        let particles = p;
         with_operator(
             rows,
             multigrid,
             nb,
-            particles,
+            p,
             set,
             surface,
             interfaces,
             |op, mg, sealed, s| {
+                if let Some(probe) = probe {
+                    probe(op);
+                }
                 let reference = s.reference;
                 ppe::source(
                     op,
@@ -100,14 +104,14 @@ impl<const D: usize> PressureSolve<D> {
                 );
                 let roles = op.roles;
                 // In a closed box the last pressure is shifted to the new reference's level.
-                let level = reference.map_or(0.0, |r| particles.pressure[r]);
+                let level = reference.map_or(0.0, |r| p.pressure[r]);
                 fill(pressure, |i| match roles[i] {
-                    Role::Interior | Role::Surface => particles.pressure[i] - level,
+                    Role::Interior | Role::Surface => p.pressure[i] - level,
                     Role::Splash | Role::Reference => 0.0,
                 });
                 let info = bicgstab.solve(op, mg, rhs, pressure, set.solver)?;
                 if reference.is_some() {
-                    zero_mean_pressure(particles, pressure);
+                    zero_mean_pressure(p, pressure);
                 }
                 Ok(info)
             },
@@ -117,31 +121,6 @@ impl<const D: usize> PressureSolve<D> {
     /// The solution of the last `run` (before the cavitation clip the particles' pressure takes).
     pub fn pressure(&self) -> &[f64] {
         &self.pressure
-    }
-
-    /// Hands `probe` the operator `run` would solve with (for `isph bench`).
-    pub fn probe<R>(
-        &mut self,
-        nb: &Neighbours<D>,
-        p: &Particles<D>,
-        set: &StepSettings<D>,
-        surface: &mut FreeSurface<D>,
-        interfaces: Option<interface::Field<D>>,
-        probe: impl FnOnce(&PressureOperator<D>) -> R,
-    ) -> Result<R, SolverError> {
-        let Self {
-            rows, multigrid, ..
-        } = self;
-        with_operator(
-            rows,
-            multigrid,
-            nb,
-            p,
-            set,
-            surface,
-            interfaces,
-            |op, _, _, _| Ok(probe(op)),
-        )
     }
 }
 
@@ -210,18 +189,6 @@ fn with_operator<const D: usize, R>(
         sealed.extend(unanchored);
     };
     solve(&op, multigrid, &sealed, &s)
-}
-
-/// The pressure the fluid takes: with a free surface the pressure is absolute (zero at the
-/// surface) and the water cannot hold a tension, so negative pressures are cut to zero; in a
-/// closed box (`clip` false) only differences count and P is kept as solved.
-#[inline]
-pub fn cavitation(clip: bool, pressure: f64) -> f64 {
-    if clip {
-        pressure.max(0.0)
-    } else {
-        pressure
-    }
 }
 
 /// Shifts the fluid pressures of a closed box to a zero mean (walls hold no unknown): the

@@ -1,11 +1,10 @@
 //! Particle shifting δr = −D ∇C (Eq. 10, `effects::shifting`) at rⁿ, then velocity and
 //! pressure carried to the shifted position by Eq. (9); the shift itself is the advection's.
 
-use super::corrector::touching_distance;
+use super::cavitation;
 use super::free_surface::Surface;
-use super::pressure_solve::cavitation;
 use super::{Stage, StepSettings};
-use crate::boundary::faces::Faces;
+use crate::boundary::faces::{self, Faces};
 use crate::effects::shifting as fickian;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::{self, fill_vector};
@@ -56,20 +55,18 @@ impl<const D: usize> Shifting<D> {
             .normals
             .expect("the free-surface stage keeps normals for shifting");
         let (roles, full) = (surface.roles, surface.full_support);
-        let touch = touching_distance(set.spacing);
-        let particles = p;
+        let touch = faces::touching_distance(set.spacing);
         fill_vector(&mut self.shift, |i| match roles[i] {
             // Splashes are left in place: neither ∇C nor the Taylor correction means anything
             // there.
             Role::Interior | Role::Surface | Role::Reference => {
-                let dr = shifting.displacement(nb, particles, normals[i], full[i], i);
-                faces.no_penetration(particles.position(i), dr, touch)
+                let dr = shifting.displacement(nb, p, normals[i], full[i], i);
+                faces.no_penetration(p.position(i), dr, touch)
             }
             Role::Splash => [0.0; D],
         });
         let shift = &self.shift;
         fill_vector(velocity, |i| {
-            let p = particles;
             // Where the free surface is in reach the velocity gradient is no longer that of a
             // filled support, and shifting moves particles into the thinning, faster parts of a
             // stretching flow: the Taylor step there feeds the flow energy

@@ -35,11 +35,14 @@ pub enum Limit {
 }
 
 impl Limit {
-    pub fn describe(self) -> &'static str {
+    /// The condition in words, with its constant.
+    pub fn describe(self) -> String {
         match self {
-            Limit::Cfl => "the CFL condition (solver.cfl × h / the largest fluid speed)",
-            Limit::Viscous => "the viscous condition (0.125 h²/ν with the largest fluid viscosity)",
-            Limit::BodyForce => "the body-force condition (0.25 √(h/|g|))",
+            Limit::Cfl => "the CFL condition (solver.cfl × h / the largest fluid speed)".into(),
+            Limit::Viscous => format!(
+                "the viscous condition ({VISCOUS_NUMBER} h²/ν with the largest fluid viscosity)"
+            ),
+            Limit::BodyForce => format!("the body-force condition ({BODY_FORCE_NUMBER} √(h/|g|))"),
         }
     }
 }

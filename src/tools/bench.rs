@@ -6,7 +6,7 @@
 //! (VmHWM) is that point's alone and its thread pool has exactly the requested size. The child
 //! builds the scene, takes warm-up steps, times the steps that follow and the time of each
 //! stage (`Simulation::timings`), then times the apply of the PPE operator the step's own
-//! stages build on the state reached (`Simulation::probe_pressure_operator`), and prints a
+//! stages build in one more step (`Simulation::advance_probing`), and prints a
 //! [`Measurement`] as TOML on stdout; the parent collects the points, prints a table and writes
 //! the CSV.
 
@@ -44,7 +44,7 @@ const APPLY_REPEATS: usize = 5;
 
 #[derive(Debug, thiserror::Error)]
 pub enum BenchError {
-    #[error("--sizes {value}: not a particle count; give whole numbers of fluid particles of at least {MIN_SIZE}, e.g. --sizes 1e4,1e5,1e6")]
+    #[error("--sizes {value:?}: not a particle count; give whole numbers of fluid particles of at least {MIN_SIZE}, e.g. --sizes 1e4,1e5,1e6")]
     Size { value: f64 },
     #[error("--threads {value}: a thread count must be at least 1, e.g. --threads 1,2")]
     Threads { value: usize },
@@ -222,13 +222,12 @@ impl Measurement {
     }
 }
 
-/// Times the PPE operator's apply on the particles' state, the operator built by the step's
-/// own stages (`Simulation::probe_pressure_operator`): (pairs per apply, seconds of each timed
-/// apply). Re-sorts the particles.
+/// Times the apply of the PPE operator of one more step, the operator its own stages build
+/// (`Simulation::advance_probing`): (pairs per apply, seconds of each timed apply).
 fn time_ppe_apply<const D: usize>(
     sim: &mut Simulation<D>,
 ) -> Result<(usize, Vec<f64>), NumericalFailure> {
-    sim.probe_pressure_operator(|op| {
+    let probed = sim.advance_probing(END_TIME, |op| {
         let x = op.p.pressure[..op.len()].to_vec();
         let mut y = vec![0.0; op.len()];
         op.apply(&x, &mut y);
@@ -240,7 +239,8 @@ fn time_ppe_apply<const D: usize>(
             })
             .collect();
         (apply_pairs(op), seconds)
-    })
+    });
+    probed.map(|(_, timed)| timed)
 }
 
 /// Fluid neighbour pairs of the interior rows of `op`, the only rows that visit their

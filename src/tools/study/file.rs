@@ -68,7 +68,7 @@ impl Study {
             if !(t.is_finite() && t > 0.0) {
                 return Err(invalid(
                     "until",
-                    format!("= {t} must be a positive number of seconds"),
+                    format!("= {t:?} must be a positive number of seconds"),
                 ));
             }
         }
