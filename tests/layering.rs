@@ -113,8 +113,8 @@ fn module_of(file: &Path) -> String {
 }
 
 /// Every `crate::…` path a source text uses, one per imported item: `use` statements
-/// (their braces expanded, across lines) and paths written inline in code. Comments are
-/// skipped.
+/// (their braces expanded, nested ones too, across lines) and paths written inline in code.
+/// Comments are skipped.
 fn crate_paths(source: &str) -> Vec<String> {
     let code: String = source
         .lines()
@@ -128,29 +128,51 @@ fn crate_paths(source: &str) -> Vec<String> {
     let mut rest = code.as_str();
     while let Some(k) = rest.find("crate::") {
         let after = &rest[k + "crate::".len()..];
-        let end = after
-            .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':' || c == '{'))
-            .unwrap_or(after.len());
-        let head = &after[..end];
-        if let Some(open) = head.find('{') {
-            let prefix = head[..open].trim_end_matches("::");
-            let close = after.find('}').unwrap_or(after.len());
-            for item in after[open + 1..close].split(',') {
-                let item = item.split_whitespace().next().unwrap_or("");
-                let item = item.split("::").next().unwrap_or("");
-                if item.is_empty() || item == "self" {
-                    paths.push(prefix.to_string());
-                } else {
-                    paths.push(format!("{prefix}::{item}"));
-                }
-            }
-            rest = &after[close.min(after.len())..];
-        } else {
-            paths.push(head.trim_end_matches(':').to_string());
-            rest = &after[end..];
-        }
+        let taken = use_tree("", after, &mut paths);
+        rest = &after[taken..];
     }
     paths
+}
+
+/// Expands the `use` tree at the start of `text` (a path, optionally ending in `{…}` groups)
+/// under `prefix` into `out`; returns how much of `text` it took.
+fn use_tree(prefix: &str, text: &str, out: &mut Vec<String>) -> usize {
+    let text_start = text.len() - text.trim_start().len();
+    let text = text.trim_start();
+    let end = text
+        .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+        .unwrap_or(text.len());
+    let head = text[..end].trim_end_matches(':');
+    let path = match (prefix, head) {
+        (p, "self") | (p, "") => p.to_string(),
+        ("", h) => h.to_string(),
+        (p, h) => format!("{p}::{h}"),
+    };
+    if !text[end..].starts_with('{') {
+        out.push(path);
+        return text_start + end;
+    }
+    // The group's items, split at the commas outside nested braces.
+    let (mut depth, mut item_start, mut k) = (0, end + 1, end);
+    for (i, c) in text[end..].char_indices() {
+        k = end + i;
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            ',' if depth == 1 => {
+                use_tree(&path, &text[item_start..k], out);
+                item_start = k + 1;
+            }
+            _ => {}
+        }
+        if depth == 0 {
+            break;
+        }
+    }
+    if !text[item_start..k].trim().is_empty() {
+        use_tree(&path, &text[item_start..k], out);
+    }
+    text_start + k + 1
 }
 
 fn starts_with_path(path: &str, prefix: &str) -> bool {
@@ -341,6 +363,18 @@ fn the_checker_finds_a_forbidden_import_and_a_circle() {
     assert_eq!(forbidden("io::stats", &io), ["step::StepSettings"]);
     // An effect may not use another; a comment is not an import.
     let les = crate_paths("// crate::step::Step\nuse crate::effects::shifting::Shifting;\n");
+    // Nested groups: every item is seen.
+    let nested =
+        crate_paths("use crate::{sph::{self, interface::Field}, step::{Step, time_step::Limit}};");
+    assert_eq!(
+        nested,
+        [
+            "sph",
+            "sph::interface::Field",
+            "step::Step",
+            "step::time_step::Limit"
+        ]
+    );
     assert_eq!(
         forbidden("effects::les", &les),
         ["effects::shifting::Shifting"]

@@ -2,8 +2,10 @@
 //! directory. `run` starts one; `resume` continues one from a checkpoint, bit for bit as if it
 //! had never stopped.
 
+mod output;
 pub(crate) mod progress;
 pub mod resume;
+mod stop;
 
 use crate::io::checkpoint::{Checkpoint, CheckpointError, RunState};
 use crate::io::checkpoint_folder;
@@ -12,22 +14,20 @@ use crate::io::stats::StatsWriter;
 use crate::io::stats::StepStats;
 use crate::io::{prepare_output_dir, xdmf, OutputError};
 use crate::math::reduce::in_pool;
+use crate::run::output::Output;
 use crate::run::progress::Progress;
+use crate::run::resume::{ResumeError, ResumeOptions};
+pub use crate::run::stop::StopSignal;
 use crate::scene::Scene;
 use crate::simulation::{NoFluid, NumericalFailure, Simulation};
 use crate::step::timings::Timings;
-use resume::{ResumeError, ResumeOptions};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;
 
 /// Frame times within this many output intervals of the end time are the end time.
 const FRAME_TIME_ROUNDING: f64 = 1e-6;
-
-/// Set to a signal number (by a signal handler, or by any thread) to stop a run after its
-/// current step: it then writes a checkpoint and returns `RunError::Interrupted`.
-pub type StopSignal = Arc<AtomicUsize>;
 
 #[derive(Clone, Debug)]
 pub struct RunOptions {
@@ -165,14 +165,6 @@ fn resume_in<const D: usize>(
         &opts.stop,
     )
     .drive()
-}
-
-/// The output directory of a run, its files open for appending, and the frames already in them.
-pub(crate) struct Output {
-    pub dir: PathBuf,
-    pub frames_out: FrameWriter,
-    pub stats: StatsWriter,
-    pub frames: Vec<FrameInfo>,
 }
 
 /// A run in progress: the simulation and everything the run carries from step to step.

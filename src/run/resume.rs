@@ -7,7 +7,8 @@ use crate::io::checkpoint_folder::{self, DIR_NAME};
 use crate::io::frames::{self, FrameWriter};
 use crate::io::stats::{self, StatsWriter};
 use crate::io::{xdmf, OutputError};
-use crate::run::{Output, RunError, StopSignal};
+use crate::run::output::Output;
+use crate::run::stop::StopSignal;
 use crate::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 
@@ -28,6 +29,8 @@ pub struct ResumeOptions {
 pub enum ResumeError {
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
     #[error("cannot read the checkpoints in {dir}: {source}")]
     Folder {
         dir: PathBuf,
@@ -118,7 +121,7 @@ pub(crate) struct Continuation {
 pub(crate) fn prepare(
     checkpoint: &Checkpoint,
     opts: &ResumeOptions,
-) -> Result<Continuation, RunError> {
+) -> Result<Continuation, ResumeError> {
     let state = &checkpoint.state;
     let path = checkpoint.path().to_owned();
     let out = output_dir(&path)?;
@@ -129,8 +132,7 @@ pub(crate) fn prepare(
             checkpoint: path,
             time: state.time,
             end,
-        }
-        .into());
+        });
     }
     let frames = frames::read_index(&out, state.frames_written as usize)?;
     if let Some(last) = frames.last().filter(|f| f.time > state.time) {
