@@ -2,7 +2,7 @@
 //! and nothing already written is touched.
 
 use crate::common::{isph_command, water_block_scene, TempDir};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Output;
 
 /// A valid scene: one 10 × 10 block of water, run for a single frame.
@@ -14,11 +14,16 @@ fn isph(args: &[&str]) -> Output {
     isph_command().args(args).output().unwrap()
 }
 
-/// Runs `isph run` on `scene` text and returns (exit code, stderr).
-fn run_text(dir: &Path, scene: &str, extra: &[&str]) -> (i32, String) {
+/// `scene` text written to `dir`/scene.toml: (that file, the output directory `dir`/out).
+fn scene_in(dir: &Path, scene: &str) -> (PathBuf, PathBuf) {
     let path = dir.join("scene.toml");
     std::fs::write(&path, scene).unwrap();
-    let out = dir.join("out");
+    (path, dir.join("out"))
+}
+
+/// Runs `isph run` on `scene` text and returns (exit code, stderr).
+fn run_text(dir: &Path, scene: &str, extra: &[&str]) -> (i32, String) {
+    let (path, out) = scene_in(dir, scene);
     let mut args = vec![
         "run",
         path.to_str().unwrap(),
@@ -265,9 +270,7 @@ fn a_run_of_more_than_ten_million_steps_is_warned_of_with_the_limit_that_sets_th
     let dir = TempDir::new("long-run");
     // ν = 1e6 m²/s: Δt = 0.125 h²/ν = 7.2e-11 s (h = 0.024 m), 9.7e9 steps to 0.7 s.
     let text = good().replace("viscosity = 1.0e-6", "viscosity = 1.0e6");
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    let out = dir.path().join("out");
+    let (path, out) = scene_in(dir.path(), &text);
     let mut child = isph_command()
         .args([
             "run",
@@ -307,9 +310,7 @@ fn the_progress_line_shows_the_end_time_as_written() {
     let dir = TempDir::new("progress-end");
     // Frames every 0.1 s: the run ends on the third, scheduled at 3 × 0.1 = 0.30000000000000004.
     let text = good().replace("output_interval = 0.01", "output_interval = 0.1");
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    let out = dir.path().join("out");
+    let (path, out) = scene_in(dir.path(), &text);
     let o = isph(&[
         "run",
         path.to_str().unwrap(),
