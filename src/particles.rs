@@ -1,6 +1,8 @@
 //! Particle storage: structure of arrays, one `Vec` per component, permuted together
 //! whenever the particles are re-sorted by cell. `id` is stable across sorts.
 
+use crate::math::reduce;
+
 /// What a particle is (the `kind` column of the output).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
@@ -152,6 +154,17 @@ impl<const D: usize> Particles<D> {
             .map(|d| self.vel[d][i] * self.vel[d][i])
             .sum::<f64>()
             .sqrt()
+    }
+
+    /// The largest speed of the fluid particles (thread-count independent).
+    pub fn max_fluid_speed(&self) -> f64 {
+        reduce::max(self.len(), |i| {
+            if self.is_fluid(i) {
+                self.speed(i)
+            } else {
+                0.0
+            }
+        })
     }
 
     #[inline]

@@ -47,10 +47,9 @@ pub fn full_support_statistics<const D: usize>(
 
 /// The largest fluid speed and the fluid's kinetic energy.
 pub fn motion<const D: usize>(p: &Particles<D>) -> (f64, f64) {
-    let fluid = |i: usize| p.is_fluid(i);
-    let max_speed = reduce::max(p.len(), |i| if fluid(i) { p.speed(i) } else { 0.0 });
+    let max_speed = p.max_fluid_speed();
     let kinetic_energy = reduce::sum(p.len(), |i| {
-        if fluid(i) {
+        if p.is_fluid(i) {
             0.5 * p.mass[i] * p.speed(i).powi(2)
         } else {
             0.0

@@ -116,7 +116,7 @@ pub enum StepError {
     LeftDomain {
         index: usize,
     },
-    /// The time step collapsed (`time_step::limit`).
+    /// The time step collapsed (`time_step::limiting`).
     Collapse {
         dt: f64,
         max_speed: f64,
@@ -264,7 +264,7 @@ impl<const D: usize> Step<D> {
         let mut laps = Laps::new(timings);
         self.cell_list.run(p)?;
         laps.lap(cell_list::NAME);
-        let limit = time_step::limit(p, self.kernel.h(), &self.settings)?;
+        let (limit, _) = time_step::limiting(p, self.kernel.h(), &self.settings)?;
         let (length, lands_on_target) = time_step::length(limit, target - time);
         let set = &self.settings;
         let dt = length.dt;

@@ -2,7 +2,6 @@
 //! on the next frame's time.
 
 use super::{StepError, StepSettings};
-use crate::math::reduce;
 use crate::particles::Particles;
 
 /// Viscous time-step limit Δt ≤ C_ν h²/ν.
@@ -56,7 +55,7 @@ pub fn limiting<const D: usize>(
     h: f64,
     set: &StepSettings<D>,
 ) -> Result<(f64, Limit), StepError> {
-    let max_speed = reduce::max(p.len(), |i| if p.is_fluid(i) { p.speed(i) } else { 0.0 });
+    let max_speed = p.max_fluid_speed();
     let g = set.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
     let (cfl, body_force) = (set.cfl * h / max_speed, BODY_FORCE_NUMBER * (h / g).sqrt());
     let viscous = VISCOUS_NUMBER * h * h / set.max_viscosity;
@@ -72,15 +71,6 @@ pub fn limiting<const D: usize>(
         Limit::Viscous
     };
     Ok((dt, limit))
-}
-
-/// `limiting`'s Δt_max alone.
-pub fn limit<const D: usize>(
-    p: &Particles<D>,
-    h: f64,
-    set: &StepSettings<D>,
-) -> Result<f64, StepError> {
-    limiting(p, h, set).map(|(dt, _)| dt)
 }
 
 /// The step of at most `limit` towards a target `remaining` ahead, and whether it lands on
