@@ -6,8 +6,8 @@
 //!
 //! The layers, lowest first (a module imports only from its own folder and the layers before
 //! it; `tests/layering.rs` holds this): [`math`], [`scene`], [`particles`], [`neighbours`],
-//! [`boundary`], [`sph`], [`solver`], `effects`, [`fill`], [`io`], `step`, [`simulation`],
-//! [`run`], [`tools`].
+//! [`boundary`], [`sph`], [`solver`], `effects`, [`fill`], [`surface`], [`io`], `step`,
+//! [`simulation`], [`run`], [`render`], [`tools`].
 
 // Axis and tensor loops index several arrays by the same d (or a, b), as the equations do.
 #![allow(clippy::needless_range_loop)]
@@ -19,11 +19,13 @@ pub mod io;
 pub mod math;
 pub mod neighbours;
 pub mod particles;
+pub mod render;
 pub mod run;
 pub mod scene;
 pub mod simulation;
 pub mod solver;
 pub mod sph;
+pub mod surface;
 pub(crate) mod step;
 pub mod tools;
 

@@ -4,7 +4,11 @@ use anyhow::{bail, Context};
 use clap::{Parser, Subcommand};
 use isph::bench::{self, BenchOptions, Schedule};
 use isph::resume::{self, ResumeOptions};
+use isph::io::surface_files;
+use isph::render::{self, ColorField, FrameChoice, RenderOptions};
+use isph::scene::SurfaceRequest;
 use isph::study::{plot, StudyOptions};
+use isph::tools::surface::{surface_run, SurfaceOptions};
 use isph::Plan;
 use isph::RunReport;
 use isph::Scene;
@@ -96,6 +100,67 @@ enum Command {
     },
     /// Print the stages, particle counts and memory of a scene without running it.
     Plan { scene: PathBuf },
+    /// Reconstruct the water surface of a run's frames (marching cubes in 3D, marching
+    /// squares in 2D) into surface.h5 + surface.xdmf and one PLY file per frame under
+    /// surface/ (docs/surface.md).
+    Surface {
+        /// The run's output directory.
+        run: PathBuf,
+        /// Frames: `all`, `last`, or numbers and inclusive ranges, comma-separated (`0,10..20`).
+        #[arg(long, default_value = "all")]
+        frames: String,
+        /// Density kernel: rectangular, quadric, quartic or gaussian (Eq. 28–31).
+        #[arg(long)]
+        kernel: Option<String>,
+        /// Kernel radius, in particle spacings [default: the kernel's own, docs/surface.md].
+        #[arg(long)]
+        radius: Option<f64>,
+        /// The most cubes over the particles' box (the paper's rule).
+        #[arg(long, conflicts_with = "cube_size")]
+        max_cubes: Option<i64>,
+        /// Cube edge, in particle spacings [default: 0.5].
+        #[arg(long)]
+        cube_size: Option<f64>,
+        /// Iso-value of the density, which is 1 inside the fluid [default: 0.5].
+        #[arg(long)]
+        iso: Option<f64>,
+        /// Also write each mesh as a Wavefront OBJ file.
+        #[arg(long)]
+        obj: bool,
+        /// Directory for the surface files [default: the run's].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Replace surface files already there.
+        #[arg(long)]
+        overwrite: bool,
+        /// Worker threads [default: all cores]. The meshes are byte-identical for any count.
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Draw a run's frames as PNG pictures: 2D particles coloured by a field, or the 3D water
+    /// surface shaded (docs/render.md).
+    Render {
+        /// The run's output directory.
+        run: PathBuf,
+        /// The frame to draw (0 is the initial state) [default: the last].
+        #[arg(long, conflicts_with = "all")]
+        frame: Option<usize>,
+        /// Draw every frame, as a numbered sequence frame_000000.png, … in the -o directory.
+        #[arg(long)]
+        all: bool,
+        /// The field that colours the picture: pressure, speed, fluid or body.
+        #[arg(long, default_value = "pressure")]
+        color: String,
+        /// Picture size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1920x1080")]
+        size: String,
+        /// A .png file (one frame) or a directory.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Worker threads [default: all cores]. The pictures are byte-identical for any count.
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Run a scene over a grid of settings, measure each run's error against a reference and
     /// plot error against wall time with its Pareto front (docs/study-format.md). Resumable:
     /// points already in OUT/study.csv are not run again.
@@ -255,6 +320,93 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 summary.checkpoint.path.display()
             );
             outln!("time per stage: {}", summary.timings);
+            Ok(())
+        }
+        Command::Surface {
+            run,
+            frames,
+            kernel,
+            radius,
+            max_cubes,
+            cube_size,
+            iso,
+            obj,
+            out,
+            overwrite,
+            threads,
+        } => {
+            start_threads(threads)?;
+            let request = SurfaceRequest {
+                kernel,
+                radius,
+                cube_size,
+                max_cubes,
+                iso,
+                obj: Some(obj),
+            };
+            let settings = request
+                .settings()
+                .map_err(|(key, what)| anyhow::anyhow!("--{} {what}", key.replace('_', "-")))?;
+            let opts = SurfaceOptions {
+                frames: Some(frames),
+                settings,
+                out,
+                overwrite,
+            };
+            let done = surface_run(&run, &opts, |f| {
+                outln!(
+                    "frame {} (t = {} s): {} cells, {} vertices, encloses {:.6e} {} (the particles: {:.6e}), {:.2} s",
+                    f.frame,
+                    printed(f.time),
+                    f.cells,
+                    f.vertices,
+                    f.enclosed,
+                    if f.dimensions == 3 { "m³" } else { "m²" },
+                    f.fluid,
+                    f.seconds
+                );
+            })?;
+            let dir = opts.out.unwrap_or(run);
+            outln!(
+                "written: {} surfaces to {} and {} (meshes in {})",
+                done.len(),
+                dir.join(surface_files::FILE_NAME).display(),
+                dir.join(surface_files::INDEX_NAME).display(),
+                dir.join(surface_files::MESH_DIR).display()
+            );
+            Ok(())
+        }
+        Command::Render {
+            run,
+            frame,
+            all,
+            color,
+            size,
+            output,
+            threads,
+        } => {
+            start_threads(threads)?;
+            let color = ColorField::from_name(&color).ok_or_else(|| {
+                anyhow::anyhow!("--color {color}: not a field; one of {}", ColorField::NAMES.join(", "))
+            })?;
+            let size = render::parse_size(&size)
+                .ok_or_else(|| anyhow::anyhow!("--size {size}: give WIDTHxHEIGHT in pixels, e.g. 1920x1080"))?;
+            let frames = match (frame, all) {
+                (Some(k), _) => FrameChoice::One(k),
+                (None, true) => FrameChoice::All,
+                (None, false) => FrameChoice::Last,
+            };
+            let opts = RenderOptions {
+                frames,
+                color,
+                size,
+                output,
+            };
+            let written = render::render_run(&run, &opts)?;
+            match written.as_slice() {
+                [one] => outln!("written: {}", one.display()),
+                many => outln!("written: {} pictures in {}", many.len(), opts.output.display()),
+            }
             Ok(())
         }
         Command::Plan { scene } => {

@@ -52,8 +52,18 @@ const RULES: &[(&str, &[&str])] = &[
             "effects",
         ],
     ),
+    // The surface sees particle positions as slices, never the simulation.
+    (
+        "surface",
+        &[
+            "math",
+            "scene::SurfaceSettings",
+            "scene::SurfaceKernel",
+            "scene::CubeRule",
+        ],
+    ),
     // io never imports the step or the solver.
-    ("io", &["math", "scene", "particles"]),
+    ("io", &["math", "scene", "particles", "surface"]),
     (
         "simulation",
         &[
@@ -77,9 +87,12 @@ const RULES: &[(&str, &[&str])] = &[
             "particles",
             "simulation",
             "step::timings",
+            "surface",
             "io",
         ],
     ),
+    // Pictures of a run's files: frames and meshes, never the simulation.
+    ("render", &["math", "scene", "surface", "io"]),
     (
         "tools",
         &[
@@ -94,8 +107,10 @@ const RULES: &[(&str, &[&str])] = &[
             "effects",
             "step",
             "simulation",
+            "surface",
             "io",
             "run",
+            "render",
         ],
     ),
 ];

@@ -20,7 +20,9 @@ fn frame(points: &[(f64, f64)]) -> Frame {
         position,
         velocity: vec![[0.0; 3]; n],
         pressure: vec![0.0; n],
+        density: vec![1000.0; n],
         kind,
+        fluid: vec![0; n],
         free_surface: vec![0; n],
     }
 }

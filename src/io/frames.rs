@@ -1,8 +1,11 @@
 //! `particles.h5`: one group per frame (`/frame_000000`, …) holding per-particle datasets in
-//! id order, with the frame's `time` and `step` as attributes. Written from one thread only.
+//! id order, with the frame's `time` and `step` as attributes; the file's own attributes give
+//! the run's `dimensions` and particle `spacing` (what `isph surface` and `isph render` need to
+//! read a frame without the scene). Written from one thread only.
 
 use super::OutputError;
 use crate::particles::{Particles, NO_FLUID};
+use crate::surface::Points;
 use std::path::{Path, PathBuf};
 
 pub const FILE_NAME: &str = "particles.h5";
@@ -60,12 +63,21 @@ pub struct FrameWriter {
 }
 
 impl FrameWriter {
-    pub fn create(dir: &Path) -> Result<Self, OutputError> {
+    /// A new particles.h5 in `dir` for a run of `dimensions` at particle `spacing`.
+    pub fn create(dir: &Path, dimensions: usize, spacing: f64) -> Result<Self, OutputError> {
         let path = dir.join(FILE_NAME);
-        let file = hdf5::File::create(&path).map_err(|source| OutputError::Hdf5 {
+        let hdf5_error = |source| OutputError::Hdf5 {
             path: path.clone(),
             source,
-        })?;
+        };
+        let file = hdf5::File::create(&path).map_err(hdf5_error)?;
+        let describe = || -> hdf5::Result<()> {
+            file.new_attr::<u64>()
+                .create("dimensions")?
+                .write_scalar(&(dimensions as u64))?;
+            file.new_attr::<f64>().create("spacing")?.write_scalar(&spacing)
+        };
+        describe().map_err(hdf5_error)?;
         Ok(Self { file, path })
     }
 
@@ -206,11 +218,27 @@ pub struct Frame {
     pub position: Vec<[f64; 3]>,
     pub velocity: Vec<[f64; 3]>,
     pub pressure: Vec<f64>,
+    pub density: Vec<f64>,
     /// 0 fluid, 1 wall (`particles::Kind` codes).
     pub kind: Vec<i32>,
+    /// Index into the scene's fluids; -1 for walls.
+    pub fluid: Vec<i32>,
     /// The PPE role of each fluid particle: 0 interior, 1 free surface, 2 spray
     /// (`ppe::Role::code`); 0 for walls.
     pub free_surface: Vec<i32>,
+}
+
+impl Frame {
+    /// The frame's fluid particles (kind 0), for a surface: a run of `dimensions` at `spacing`.
+    pub fn fluid_points(&self, dimensions: usize, spacing: f64) -> Points {
+        let fluid: Vec<usize> = (0..self.kind.len()).filter(|&i| self.kind[i] == 0).collect();
+        Points {
+            dimensions,
+            spacing,
+            position: fluid.iter().map(|&i| self.position[i]).collect(),
+            velocity: fluid.iter().map(|&i| self.velocity[i]).collect(),
+        }
+    }
 }
 
 /// Reads the frames of a finished (or running) run's particles.h5.
@@ -240,6 +268,18 @@ impl FrameReader {
         }
     }
 
+    /// The run's `dimensions` and particle `spacing`, from the file's attributes.
+    pub fn geometry(&self) -> Result<(usize, f64), OutputError> {
+        let read = || -> hdf5::Result<(usize, f64)> {
+            let dimensions: u64 = self.file.attr("dimensions")?.read_scalar()?;
+            Ok((dimensions as usize, self.file.attr("spacing")?.read_scalar()?))
+        };
+        read().map_err(|_| OutputError::Malformed {
+            path: self.path.clone(),
+            what: "it lacks the `dimensions` and `spacing` attributes of the file (written by an isph older than its surface reconstruction): run the scene again".into(),
+        })
+    }
+
     /// The time of every frame, in frame order.
     pub fn times(&self) -> Result<Vec<f64>, OutputError> {
         let names = self.file.member_names().map_err(|e| self.error(e))?;
@@ -265,7 +305,9 @@ impl FrameReader {
                 position: triples("position")?,
                 velocity: triples("velocity")?,
                 pressure: g.dataset("pressure")?.read_raw()?,
+                density: g.dataset("density")?.read_raw()?,
                 kind: g.dataset("kind")?.read_raw()?,
+                fluid: g.dataset("fluid")?.read_raw()?,
                 free_surface: g.dataset("free_surface")?.read_raw()?,
             })
         };

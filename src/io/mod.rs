@@ -5,6 +5,7 @@ pub mod checkpoint;
 pub mod checkpoint_folder;
 pub mod frames;
 pub mod stats;
+pub mod surface_files;
 pub mod xdmf;
 
 use std::path::{Path, PathBuf};
@@ -60,6 +61,15 @@ pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError
             }
             std::fs::remove_file(dir.join(file)).map_err(dir_error)?;
         }
+    }
+    // A surface is the run's own: an overwritten run takes its surfaces with it.
+    for file in [surface_files::FILE_NAME, surface_files::INDEX_NAME] {
+        if overwrite && dir.join(file).exists() {
+            std::fs::remove_file(dir.join(file)).map_err(dir_error)?;
+        }
+    }
+    if overwrite && dir.join(surface_files::MESH_DIR).is_dir() {
+        std::fs::remove_dir_all(dir.join(surface_files::MESH_DIR)).map_err(dir_error)?;
     }
     let checkpoints = checkpoint_folder::folder(dir);
     if checkpoints.exists() {

@@ -12,6 +12,7 @@ use crate::io::checkpoint_folder;
 use crate::io::frames::{FrameInfo, FrameWriter};
 use crate::io::stats::StatsWriter;
 use crate::io::stats::StepStats;
+use crate::io::surface_files::SurfaceWriter;
 use crate::io::{prepare_output_dir, xdmf, OutputError};
 use crate::math::reduce::in_pool;
 use crate::run::output::Output;
@@ -21,6 +22,7 @@ pub use crate::run::stop::StopSignal;
 use crate::scene::Scene;
 use crate::simulation::{NoFluid, NumericalFailure, Simulation};
 use crate::step::timings::Timings;
+use crate::surface;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
@@ -126,9 +128,13 @@ fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary
     prepare_output_dir(&opts.out, opts.overwrite)?;
     let output = Output {
         dir: opts.out.clone(),
-        frames_out: FrameWriter::create(&opts.out)?,
+        frames_out: FrameWriter::create(&opts.out, D, scene.spacing)?,
         stats: StatsWriter::create(&opts.out)?,
         frames: Vec::new(),
+        surfaces: match scene.surface {
+            Some(settings) => Some((SurfaceWriter::create(&opts.out)?, settings)),
+            None => None,
+        },
     };
     let mut driver = Driver::new(scene, sim, output, None, opts.until, opts.quiet, &opts.stop);
     // Frame 0: the initial state.
@@ -286,6 +292,17 @@ impl<'a, const D: usize> Driver<'a, D> {
             .write(index, &self.sim.particles, self.sim.time, self.sim.step)?;
         o.frames.push(frame);
         xdmf::write(&o.dir, &o.frames)?;
+        if let Some((writer, settings)) = &mut o.surfaces {
+            let points = output::fluid_points(&self.sim.particles, self.scene.spacing);
+            // A surface that cannot be built (the fluid spread over more cubes than allowed)
+            // is not worth a run that may have days behind it: the frame goes without one.
+            match surface::reconstruct(&points, settings) {
+                Ok(mesh) => {
+                    writer.write(index, self.sim.time, &mesh, settings.obj)?;
+                }
+                Err(e) => eprintln!("warning: frame {index} (t = {} s) has no surface: {e}", self.sim.time),
+            }
+        }
         o.stats.flush()?;
         // A frame at the end time before the scheduled one leaves that one due.
         if scheduled {

@@ -2,6 +2,10 @@
 
 use crate::io::frames::{FrameInfo, FrameWriter};
 use crate::io::stats::StatsWriter;
+use crate::io::surface_files::SurfaceWriter;
+use crate::particles::Particles;
+use crate::scene::SurfaceSettings;
+use crate::surface::Points;
 use std::path::PathBuf;
 
 /// The output directory of a run, its files open for appending, and the frames already in them.
@@ -10,4 +14,19 @@ pub(crate) struct Output {
     pub frames_out: FrameWriter,
     pub stats: StatsWriter,
     pub frames: Vec<FrameInfo>,
+    /// `[output.surface]`: surface.h5 and the meshes, with their settings.
+    pub surfaces: Option<(SurfaceWriter, SurfaceSettings)>,
+}
+
+/// The fluid particles of `p` in id order, as a frame lists them: the surface built during a
+/// run is the one `isph surface` builds from its frame.
+pub(crate) fn fluid_points<const D: usize>(p: &Particles<D>, spacing: f64) -> Points {
+    let fluid: Vec<usize> = p.index_by_id().into_iter().map(|i| i as usize).filter(|&i| p.is_fluid(i)).collect();
+    let triple = |c: &[Vec<f64>; D], i: usize| -> [f64; 3] { std::array::from_fn(|d| if d < D { c[d][i] } else { 0.0 }) };
+    Points {
+        dimensions: D,
+        spacing,
+        position: fluid.iter().map(|&i| triple(&p.pos, i)).collect(),
+        velocity: fluid.iter().map(|&i| triple(&p.vel, i)).collect(),
+    }
 }

@@ -6,6 +6,7 @@ use crate::io::checkpoint::{Checkpoint, CheckpointError};
 use crate::io::checkpoint_folder::{self, DIR_NAME};
 use crate::io::frames::{self, FrameWriter};
 use crate::io::stats::{self, StatsWriter};
+use crate::io::surface_files::{self, SurfaceWriter};
 use crate::io::{xdmf, OutputError};
 use crate::run::output::Output;
 use crate::run::stop::StopSignal;
@@ -159,6 +160,13 @@ pub(crate) fn prepare(
     let stats = StatsWriter::append_at(&out, stats_length)?;
     frames_out.remove_frames_from(frames.len())?;
     xdmf::write(&out, &frames)?;
+    let surfaces = match scene.surface {
+        Some(settings) if out.join(surface_files::FILE_NAME).exists() => {
+            Some((SurfaceWriter::reopen(&out, frames.len())?, settings))
+        }
+        Some(settings) => Some((SurfaceWriter::create(&out)?, settings)),
+        None => None,
+    };
     Ok(Continuation {
         scene,
         output: Output {
@@ -166,6 +174,7 @@ pub(crate) fn prepare(
             frames_out,
             stats,
             frames,
+            surfaces,
         },
     })
 }

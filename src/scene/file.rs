@@ -24,6 +24,27 @@ pub(super) struct SceneFile {
     pub(super) effects: EffectsSection,
     #[serde(default)]
     pub(super) walls: WallSettings,
+    #[serde(default)]
+    pub(super) output: OutputSection,
+}
+
+/// `[output]`: what a run writes besides the particles.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct OutputSection {
+    pub(super) surface: Option<SurfaceSection>,
+}
+
+/// `[output.surface]`: every key optional (docs/scene-format.md).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SurfaceSection {
+    pub(super) kernel: Option<String>,
+    pub(super) radius: Option<f64>,
+    pub(super) cube_size: Option<f64>,
+    pub(super) max_cubes: Option<i64>,
+    pub(super) iso: Option<f64>,
+    pub(super) obj: Option<bool>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -3,9 +3,11 @@
 
 mod effects;
 mod file;
+mod surface;
 mod validate;
 
 pub use effects::{Effects, LesSettings, ShiftingSettings};
+pub use surface::{CubeRule, SurfaceKernel, SurfaceRequest, SurfaceSettings};
 
 pub use crate::math::aabb::Aabb;
 use crate::math::kernel::SUPPORT_IN_H;
@@ -162,6 +164,8 @@ pub struct Scene {
     pub solver: SolverSettings,
     pub checkpoint: CheckpointSettings,
     pub effects: Effects,
+    /// `[output.surface]`: the surface reconstructed at every frame (None: particles only).
+    pub surface: Option<SurfaceSettings>,
     pub walls: WallSettings,
 }
 
@@ -227,7 +231,7 @@ impl Scene {
     /// A hash of everything in the validated scene that shapes the trajectory: xxh3-64 of its
     /// Debug rendering (which prints every f64 so that it reads back to the same bits), with the
     /// fields that cannot change a step blanked: the file's path, the run's name, `end_time`
-    /// (`--until` overrides it anyway) and the checkpoint cadence. So comments, formatting and
+    /// (`--until` overrides it anyway), the checkpoint cadence and the surface output. So comments, formatting and
     /// defaults written out do not count, and a run can be extended or checkpointed differently
     /// and still resume without `--force`.
     pub fn content_hash(&self) -> u64 {
@@ -236,6 +240,7 @@ impl Scene {
             name: String::new(),
             end_time: 0.0,
             checkpoint: CheckpointSettings::default(),
+            surface: None,
             ..self.clone()
         };
         xxhash_rust::xxh3::xxh3_64(format!("{trajectory:?}").as_bytes())

@@ -3,11 +3,11 @@
 
 use super::file::{
     BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection, SceneFile,
-    ShiftingSection,
+    ShiftingSection, SurfaceSection,
 };
 use super::{
     Aabb, Block, CheckpointSettings, Effects, InitialVelocity, LesSettings, Scene, SceneError,
-    ShiftingSettings, SolverSettings,
+    ShiftingSettings, SolverSettings, SurfaceRequest, SurfaceSettings,
 };
 use crate::math::kernel::SUPPORT_IN_H;
 use std::path::Path;
@@ -248,6 +248,7 @@ impl Validator<'_> {
             .transpose()?;
         let checkpoint = self.checkpoint(&f.checkpoint)?;
         let effects = self.effects(&f.effects)?;
+        let surface = f.output.surface.as_ref().map(|s| self.surface(s)).transpose()?;
 
         let name = match &s.name {
             Some(n) => {
@@ -288,6 +289,7 @@ impl Validator<'_> {
             checkpoint,
             effects,
             walls: f.walls,
+            surface,
         };
         self.fits_in_memory(&scene)?;
         Ok(scene)
@@ -495,6 +497,20 @@ impl Validator<'_> {
             ),
         )?;
         Ok(Some(settings))
+    }
+
+    fn surface(&self, s: &SurfaceSection) -> Result<SurfaceSettings, SceneError> {
+        let request = SurfaceRequest {
+            kernel: s.kernel.clone(),
+            radius: s.radius,
+            cube_size: s.cube_size,
+            max_cubes: s.max_cubes,
+            iso: s.iso,
+            obj: s.obj,
+        };
+        request
+            .settings()
+            .map_err(|(key, message)| self.error(&format!("output.surface.{key}"), message))
     }
 
     fn checkpoint(&self, c: &CheckpointSection) -> Result<CheckpointSettings, SceneError> {
