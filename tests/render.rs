@@ -4,6 +4,7 @@
 
 use crate::common::{run_scene, scene_from_text, water_block_scene, TempDir};
 use isph::io::frames::FrameReader;
+use isph::io::surface_files::SurfaceWriter;
 use isph::render::bounds::{self, Bounds};
 use isph::render::field::nice_ceiling;
 use isph::render::survey::Survey;
@@ -151,6 +152,27 @@ fn a_3d_frame_is_a_picture_of_the_asked_size_the_same_every_time() {
     }
 }
 
+/// The pictures (the reconstructed surface included) are the same bytes whatever the number
+/// of threads (habit 5 of STYLE.md).
+#[test]
+fn pictures_do_not_depend_on_the_thread_count() {
+    let dir = TempDir::new("render-threads");
+    let run = run_3d(dir.path());
+    let bytes = |threads: usize, color: ColorField| {
+        let png = dir.path().join(format!("{threads}-{}.png", color.name()));
+        let opts = options(FrameChoice::Last, color, (320, 240), &png);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| render(&run, &opts));
+        std::fs::read(&png).unwrap()
+    };
+    for color in [ColorField::Speed, ColorField::Pressure] {
+        assert_eq!(bytes(1, color), bytes(2, color), "{}", color.name());
+    }
+}
+
 /// A closed sphere of radius `r` around `c`, a UV mesh with outward normals, its velocity
 /// growing with height.
 fn sphere_mesh(c: [f64; 3], r: f64) -> Mesh {
@@ -214,6 +236,41 @@ fn a_surface_mesh_is_drawn_shaded_and_coloured_by_speed() {
     colours.sort_unstable();
     colours.dedup();
     assert!(colours.len() > 500, "{} colours", colours.len());
+    // With no surface (an empty mesh), the fluid particles are drawn instead.
+    let empty = Mesh {
+        dimensions: 3,
+        ..Mesh::default()
+    };
+    let particles = view_3d::draw(&frame, &empty, &survey, (400, 300)).unwrap();
+    assert_ne!(particles, image);
+    let inked = particles
+        .rgb
+        .chunks_exact(3)
+        .filter(|c| c != &[255; 3])
+        .count();
+    assert!(inked > 400 * 300 / 20, "{inked} pixels drawn");
+}
+
+/// A surface that surface.h5 holds for a frame (from `isph surface`) is drawn rather than one
+/// reconstructed; pictures of particles do not read it.
+#[test]
+fn a_stored_surface_is_drawn_in_place_of_a_reconstructed_one() {
+    let dir = TempDir::new("render-stored");
+    let run = run_3d(dir.path());
+    let bytes = |color: ColorField| {
+        let png = dir.path().join(format!("{}.png", color.name()));
+        render(&run, &options(FrameChoice::Last, color, (320, 240), &png));
+        std::fs::read(&png).unwrap()
+    };
+    let (speed, pressure) = (bytes(ColorField::Speed), bytes(ColorField::Pressure));
+    let time = FrameReader::open(&run).unwrap().times().unwrap()[1];
+    let mut writer = SurfaceWriter::create(&run).unwrap();
+    writer
+        .write(1, time, &sphere_mesh([0.12, 0.04, 0.08], 0.05), false)
+        .unwrap();
+    drop(writer);
+    assert_ne!(bytes(ColorField::Speed), speed);
+    assert_eq!(bytes(ColorField::Pressure), pressure);
 }
 
 #[test]
@@ -311,29 +368,4 @@ fn the_container_is_found_inside_its_wall_layers() {
         assert!((inner.min[d] - expected.min[d]).abs() < 1e-9, "{inner:?}");
         assert!((inner.max[d] - expected.max[d]).abs() < 1e-9, "{inner:?}");
     }
-}
-
-/// Renders a finished run for a look (docs/render.md): ISPH_RENDER_RUN=DIR, optional
-/// ISPH_RENDER_FRAME=K, ISPH_RENDER_COLOR=NAME, ISPH_RENDER_SIZE=WxH,
-/// ISPH_RENDER_OUT=PNG.
-#[test]
-#[ignore]
-fn render_the_run_named_by_the_environment() {
-    let Ok(run) = std::env::var("ISPH_RENDER_RUN") else {
-        return;
-    };
-    let frames = match std::env::var("ISPH_RENDER_FRAME") {
-        Ok(k) => FrameChoice::One(k.parse().unwrap()),
-        Err(_) => FrameChoice::Last,
-    };
-    let color = std::env::var("ISPH_RENDER_COLOR").unwrap_or("pressure".into());
-    let out = std::env::var("ISPH_RENDER_OUT").unwrap_or("/tmp/render.png".into());
-    let size = std::env::var("ISPH_RENDER_SIZE").unwrap_or("1920x1080".into());
-    let opts = options(
-        frames,
-        ColorField::from_name(&color).unwrap(),
-        isph::render::parse_size(&size).unwrap(),
-        Path::new(&out),
-    );
-    println!("{:?}", render(Path::new(&run), &opts));
 }

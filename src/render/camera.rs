@@ -1,7 +1,8 @@
 //! The 3D camera: a fixed oblique direction (azimuth −60°, elevation 25°, z up, the way
 //! gravity points in every 3D scene of isph), at a distance where a 30° lens holds the box's
 //! bounding sphere, then zoomed and shifted so that the box's eight corners fill the viewport.
-//! It depends on the box alone, so every frame of a rendering is seen from the same place.
+//! It depends on the box alone (`Survey::drawn_box`, over all the frames rendered), so every
+//! frame of a rendering is seen from the same place.
 
 use super::bounds::Bounds;
 use super::raster::Rect;

@@ -302,8 +302,3 @@ pub fn viridis(t: f64) -> Rgb {
 pub fn category(index: usize) -> Rgb {
     CATEGORIES[index % CATEGORIES.len()]
 }
-
-/// `colour` scaled by `light` (0 black, 1 itself), for shading.
-pub fn shade(colour: Rgb, light: f64) -> Rgb {
-    colour.map(|c| (c as f64 * light).round().clamp(0.0, 255.0) as u8)
-}

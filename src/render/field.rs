@@ -44,11 +44,6 @@ impl ColorField {
         }
     }
 
-    /// Whether the field is a number on a colour scale (rather than categories).
-    pub fn is_scalar(self) -> bool {
-        matches!(self, Self::Pressure | Self::Speed)
-    }
-
     /// The field's value at particle `i` in SI units (0 for categorical fields).
     pub fn value(self, frame: &Frame, i: usize) -> f64 {
         match self {

@@ -13,12 +13,12 @@ static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Registers the font with plotters, once per process. With plotters' `ab_glyph` feature,
 /// plotters has no font at all until one is registered: text layout fails without this.
-pub fn register() -> Result<(), &'static str> {
+pub fn register() -> Result<(), String> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE.get_or_init(|| register_font(FAMILY, FontStyle::Normal, DEJAVU_SANS).is_ok());
     if ok {
         Ok(())
     } else {
-        Err("the embedded DejaVu Sans font could not be parsed")
+        Err("the embedded DejaVu Sans font could not be parsed".to_owned())
     }
 }

@@ -27,7 +27,10 @@ pub mod view_3d;
 pub use field::ColorField;
 
 use crate::io::frames::{self, Frame, FrameReader};
+use crate::io::surface_files::{self, SurfaceReader};
 use crate::io::OutputError;
+use crate::surface::Mesh;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use survey::Survey;
 
@@ -119,58 +122,109 @@ pub fn render_run(run_dir: &Path, opts: &RenderOptions) -> Result<Vec<PathBuf>, 
     if !side_ok(width) || !side_ok(height) {
         return Err(RenderError::Size { width, height });
     }
-    if !run_dir.join(frames::FILE_NAME).is_file() {
-        return Err(RenderError::NoRun {
-            dir: run_dir.to_owned(),
-            file: frames::FILE_NAME,
-        });
-    }
-    let path = run_dir.join(frames::FILE_NAME);
-    let read_error = |source| RenderError::Read {
-        path: path.clone(),
-        source,
-    };
-    let reader = FrameReader::open(run_dir).map_err(read_error)?;
-    let frames = chosen_frames(
-        opts.frames,
-        reader.times().map_err(read_error)?.len(),
-        &path,
-    )?;
-    let (dimensions, spacing) = reader.geometry().map_err(read_error)?;
-    if !(2..=3).contains(&dimensions) {
-        return Err(RenderError::Dimensions { path, dimensions });
-    }
+    let run = Run::open(run_dir)?;
+    let frames = chosen_frames(opts.frames, run.count, &run.path)?;
     let targets = output::targets(&opts.output, &frames)?;
-    font::register().map_err(|message| RenderError::Draw {
-        path: path.clone(),
-        frame: frames[0],
-        message: message.to_owned(),
-    })?;
     // The survey reads every frame once before any is drawn; one frame is read only once.
-    let mut survey = Survey::new(dimensions, spacing, opts.color);
-    let mut kept: Option<Frame> = None;
+    let mut survey = Survey::new(run.dimensions, run.spacing, opts.color);
+    let mut kept = Vec::new();
     for &k in &frames {
-        let frame = reader.read(k).map_err(read_error)?;
+        let frame = run.frame(k)?;
         survey.add(&frame);
         if frames.len() == 1 {
-            kept = Some(frame);
+            kept.push(frame);
         }
     }
-    for (&k, target) in frames.iter().zip(&targets) {
-        let frame = match kept.take() {
-            Some(frame) => frame,
-            None => reader.read(k).map_err(read_error)?,
-        };
-        let image = picture(&frame, k, &survey, opts, &path)?;
-        let write_error = |source| RenderError::Write {
-            path: target.clone(),
-            source,
-        };
-        let bytes = png_file::encode(&image)
-            .map_err(|e| write_error(std::io::Error::other(e.to_string())))?;
-        png_file::write_atomically(target, &bytes).map_err(write_error)?;
+    let jobs: Vec<(usize, &PathBuf)> = frames.iter().copied().zip(&targets).collect();
+    // As many frames at a time as there are threads: read here (HDF5 from one thread only),
+    // then drawn, encoded and written in parallel, each picture on its own.
+    for chunk in jobs.chunks(rayon::current_num_threads().max(1)) {
+        let inputs = chunk
+            .iter()
+            .map(|&(k, target)| {
+                let frame = match kept.pop() {
+                    Some(frame) => frame,
+                    None => run.frame(k)?,
+                };
+                Ok((k, frame, run.stored_surface(k, &survey)?, target))
+            })
+            .collect::<Result<Vec<_>, RenderError>>()?;
+        inputs
+            .into_par_iter()
+            .map(|(k, frame, stored, target)| {
+                let image = picture(&frame, k, stored, &survey, opts.size, &run.path)?;
+                write_png(&image, target)
+            })
+            .collect::<Result<Vec<()>, RenderError>>()?;
     }
     Ok(targets)
+}
+
+/// A run's particles.h5 and surface.h5, opened for reading.
+struct Run {
+    path: PathBuf,
+    reader: FrameReader,
+    surfaces: Option<SurfaceReader>,
+    count: usize,
+    dimensions: usize,
+    spacing: f64,
+}
+
+impl Run {
+    fn open(dir: &Path) -> Result<Self, RenderError> {
+        let path = dir.join(frames::FILE_NAME);
+        if !path.is_file() {
+            return Err(RenderError::NoRun {
+                dir: dir.to_owned(),
+                file: frames::FILE_NAME,
+            });
+        }
+        let read_error = |source| RenderError::Read {
+            path: path.clone(),
+            source,
+        };
+        let reader = FrameReader::open(dir).map_err(read_error)?;
+        let count = reader.times().map_err(read_error)?.len();
+        let (dimensions, spacing) = reader.geometry().map_err(read_error)?;
+        if !(2..=3).contains(&dimensions) {
+            return Err(RenderError::Dimensions { path, dimensions });
+        }
+        let surfaces = SurfaceReader::open(dir).map_err(|source| RenderError::Read {
+            path: dir.join(surface_files::FILE_NAME),
+            source,
+        })?;
+        Ok(Self {
+            path,
+            reader,
+            surfaces,
+            count,
+            dimensions,
+            spacing,
+        })
+    }
+
+    fn frame(&self, k: usize) -> Result<Frame, RenderError> {
+        self.reader.read(k).map_err(|source| RenderError::Read {
+            path: self.path.clone(),
+            source,
+        })
+    }
+
+    /// The surface of frame `k` that surface.h5 holds (written by `isph surface` or by the run),
+    /// if the picture shows a surface and there is one.
+    fn stored_surface(&self, k: usize, survey: &Survey) -> Result<Option<Mesh>, RenderError> {
+        let Some(reader) = &self.surfaces else {
+            return Ok(None);
+        };
+        if survey.dimensions != 3 || !view_3d::shows_surface(survey) {
+            return Ok(None);
+        }
+        let stored = reader.read(k).map_err(|source| RenderError::Read {
+            path: self.path.with_file_name(surface_files::FILE_NAME),
+            source,
+        })?;
+        Ok(stored.filter(|m| m.dimensions == 3))
+    }
 }
 
 /// The frame numbers `choice` names among `count` frames.
@@ -197,27 +251,48 @@ fn chosen_frames(
     }
 }
 
-/// The picture of frame number `k`.
+/// The picture of frame number `k`; in 3D with the `stored` surface, or else one reconstructed
+/// from its particles (none when the picture shows particles).
 fn picture(
     frame: &Frame,
     k: usize,
+    stored: Option<Mesh>,
     survey: &Survey,
-    opts: &RenderOptions,
+    size: (u32, u32),
     path: &Path,
 ) -> Result<raster::Image, RenderError> {
     let drawn = if survey.dimensions == 2 {
-        plot_2d::draw(frame, survey, opts.size)
+        plot_2d::draw(frame, survey, size)
     } else {
-        let mesh = view_3d::surface(frame, survey).map_err(|source| RenderError::Surface {
-            path: path.to_owned(),
-            frame: k,
-            source,
-        })?;
-        view_3d::draw(frame, &mesh, survey, opts.size)
+        let mesh = match stored {
+            Some(mesh) => mesh,
+            None if view_3d::shows_surface(survey) => {
+                view_3d::reconstruct(frame, survey).map_err(|source| RenderError::Surface {
+                    path: path.to_owned(),
+                    frame: k,
+                    source,
+                })?
+            }
+            None => Mesh {
+                dimensions: 3,
+                ..Mesh::default()
+            },
+        };
+        view_3d::draw(frame, &mesh, survey, size)
     };
     drawn.map_err(|message| RenderError::Draw {
         path: path.to_owned(),
         frame: k,
         message,
     })
+}
+
+fn write_png(image: &raster::Image, target: &Path) -> Result<(), RenderError> {
+    let write_error = |source| RenderError::Write {
+        path: target.to_owned(),
+        source,
+    };
+    let bytes =
+        png_file::encode(image).map_err(|e| write_error(std::io::Error::other(e.to_string())))?;
+    png_file::write_atomically(target, &bytes).map_err(write_error)
 }

@@ -83,11 +83,7 @@ pub fn legend_width(legend: &Legend, style: &Style) -> i32 {
     let t = style.text;
     match legend {
         Legend::Bar { factor, max, .. } => {
-            let widest = [0.0, 0.55, 0.75, 1.0]
-                .map(|f| style.width_of(&tick_label(f * max * factor)))
-                .into_iter()
-                .max()
-                .unwrap_or(0);
+            let widest = widest_tick_label(max * factor, style);
             t + bar_width(style) + tick_area(style, widest) + t / 2
         }
         Legend::Swatches(items) => {
@@ -99,6 +95,16 @@ pub fn legend_width(legend: &Legend, style: &Style) -> i32 {
             t + swatch_size(style) + t / 2 + widest
         }
     }
+}
+
+/// The width of the widest label a colour bar from 0 to `top` may get: plotters picks the ticks,
+/// so a few values across the scale (a third decimal where they are not round) stand for them.
+fn widest_tick_label(top: f64, style: &Style) -> i32 {
+    [0.0, 0.55, 0.75, 1.0]
+        .map(|f| style.width_of(&tick_label(f * top)))
+        .into_iter()
+        .max()
+        .unwrap_or(0)
 }
 
 fn bar_width(style: &Style) -> i32 {
@@ -149,11 +155,7 @@ pub fn legend(root: &Area, legend: &Legend, bar: Rect, style: &Style) -> Result<
     let err = |e: DrawingAreaErrorKind<_>| e.to_string();
     match legend {
         Legend::Bar { factor, max, .. } => {
-            let widest = [0.0, 0.55, 0.75, 1.0]
-                .map(|f| style.width_of(&tick_label(f * max * factor)))
-                .into_iter()
-                .max()
-                .unwrap_or(0);
+            let widest = widest_tick_label(max * factor, style);
             let ticks = tick_area(style, widest);
             let area = root.clone().shrink((bar.x, bar.y), (bar.w + ticks, bar.h));
             let top = max * factor;

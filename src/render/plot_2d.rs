@@ -87,6 +87,7 @@ impl Layout {
 
 /// The picture of `frame`.
 pub fn draw(frame: &Frame, survey: &Survey, size: (u32, u32)) -> Result<Image, String> {
+    super::font::register()?;
     let style = Style::for_size(size.0, size.1);
     let legend = survey.colouring.legend();
     let layout = Layout::new(survey, &legend, size, &style);

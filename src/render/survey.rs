@@ -11,8 +11,10 @@ use crate::io::frames::Frame;
 pub struct Survey {
     pub dimensions: usize,
     pub spacing: f64,
-    /// Every particle of every frame surveyed.
+    /// Every particle of every frame surveyed: what the 2D axes show.
     pub bounds: Bounds,
+    /// Every fluid and body particle of every frame surveyed.
+    pub moving: Bounds,
     /// The container's inner box (from the first frame's walls), if it has walls.
     pub container: Option<Bounds>,
     pub colouring: Colouring,
@@ -26,6 +28,7 @@ impl Survey {
             dimensions,
             spacing,
             bounds: Bounds::default(),
+            moving: Bounds::default(),
             container: None,
             colouring: Colouring {
                 field,
@@ -52,18 +55,37 @@ impl Survey {
         for i in 0..frame.kind.len() {
             match frame.kind[i] {
                 FLUID => {
+                    self.moving.include(&frame.position[i]);
                     values.push(c.field.value(frame, i));
                     if let Err(at) = c.fluids.binary_search(&frame.fluid[i]) {
                         c.fluids.insert(at, frame.fluid[i]);
                     }
                 }
-                BODY => c.bodies = true,
+                BODY => {
+                    self.moving.include(&frame.position[i]);
+                    c.bodies = true;
+                }
                 _ => {}
             }
         }
         self.largest = self.largest.max(top_of_scale(values));
         // Rounded up so that the bar's ticks come out round.
         c.max = super::field::nice_ceiling(self.largest);
+    }
+
+    /// What the 3D camera frames: everything the picture draws, the container's inner box and
+    /// the water and bodies in it (the wall particles, not drawn, would only add a border of
+    /// their thickness).
+    pub fn drawn_box(&self) -> Bounds {
+        let mut b = self.moving;
+        if let Some(container) = &self.container {
+            b.merge(container);
+        }
+        if b.is_empty() {
+            self.bounds
+        } else {
+            b
+        }
     }
 }
 

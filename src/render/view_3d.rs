@@ -36,25 +36,19 @@ pub fn shows_surface(survey: &Survey) -> bool {
     }
 }
 
-/// The water surface of `frame`, reconstructed from its fluid particles (an empty mesh when
-/// the picture shows particles instead).
-pub fn surface(frame: &Frame, survey: &Survey) -> Result<Mesh, SurfaceError> {
+/// The water surface of `frame`, reconstructed from its fluid particles with the default
+/// settings.
+pub fn reconstruct(frame: &Frame, survey: &Survey) -> Result<Mesh, SurfaceError> {
     let mut points = Points {
         dimensions: 3,
         spacing: survey.spacing,
         ..Points::default()
     };
-    if shows_surface(survey) {
-        for i in (0..frame.kind.len()).filter(|&i| frame.kind[i] == FLUID) {
-            points.position.push(frame.position[i]);
-            points.velocity.push(frame.velocity[i]);
-        }
-        return surface::reconstruct(&points, &SurfaceSettings::default());
+    for i in (0..frame.kind.len()).filter(|&i| frame.kind[i] == FLUID) {
+        points.position.push(frame.position[i]);
+        points.velocity.push(frame.velocity[i]);
     }
-    Ok(Mesh {
-        dimensions: 3,
-        ..Mesh::default()
-    })
+    surface::reconstruct(&points, &SurfaceSettings::default())
 }
 
 /// The picture of `frame` with its surface `mesh`.
@@ -64,10 +58,12 @@ pub fn draw(
     survey: &Survey,
     size: (u32, u32),
 ) -> Result<Image, String> {
+    super::font::register()?;
     let style = Style::for_size(size.0, size.1);
     let legend = survey.colouring.legend();
     let t = style.text;
     let right = overlay::legend_width(&legend, &style);
+    // Three text heights above for the title, a margin of one on the other sides.
     let viewport = Rect {
         x: t,
         y: 3 * t,
@@ -75,8 +71,8 @@ pub fn draw(
         h: (size.1 as i32 - 4 * t).max(1),
     };
     let mut image = Image::new(size.0, size.1, [255; 3]);
+    let (camera, shown) = centred_camera(survey, viewport, right, size.0 as i32);
     {
-        let camera = Camera::fitted(&survey.bounds, viewport);
         let mut depth = DepthImage::new(&mut image, camera, viewport);
         floor(&mut depth, survey);
         if shows_surface(survey) && mesh.cell_count() > 0 {
@@ -87,23 +83,47 @@ pub fn draw(
         particles(&mut depth, frame, survey, |kind| kind == BODY);
         container_edges(&mut depth, survey, style.line as i32);
     }
-    let bar = overlay::bar_rect(viewport, viewport.h * 3 / 5, &style);
+    let bar = overlay::bar_rect(shown, shown.h * 3 / 5, &style);
     let bar = match legend {
         Legend::Bar { .. } => {
             overlay::paint_bar(&mut image, bar);
             bar
         }
         Legend::Swatches(_) => Rect {
-            y: viewport.y + t,
+            y: shown.y + t,
             ..bar
         },
     };
     let root = BitMapBackend::with_buffer(&mut image.rgb, size).into_drawing_area();
-    overlay::title(&root, &overlay::time_title(frame.time), viewport, &style)?;
+    overlay::title(&root, &overlay::time_title(frame.time), shown, &style)?;
     overlay::legend(&root, &legend, bar, &style)?;
     root.present().map_err(|e| e.to_string())?;
     drop(root);
     Ok(image)
+}
+
+/// The camera fitted to the viewport, moved sideways so that the box it shows and the legend
+/// (`legend_width` wide) are centred together in the picture's `width`, and the columns the
+/// box takes on the screen (as tall as the viewport), beside which the legend goes.
+fn centred_camera(
+    survey: &Survey,
+    viewport: Rect,
+    legend_width: i32,
+    width: i32,
+) -> (Camera, Rect) {
+    let drawn = survey.drawn_box();
+    let mut camera = Camera::fitted(&drawn, viewport);
+    let xs = drawn.corners().map(|c| camera.project(c).x);
+    let left = xs.iter().copied().fold(f64::INFINITY, f64::min).floor() as i32;
+    let right = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max).ceil() as i32;
+    let shift = (width - (right - left) - legend_width) / 2 - left;
+    camera.centre.0 += shift as f64;
+    let shown = Rect {
+        x: left + shift,
+        w: right - left,
+        ..viewport
+    };
+    (camera, shown)
 }
 
 /// The container's floor (the bottom face of its inner box), under everything else.
@@ -130,23 +150,26 @@ fn floor(depth: &mut DepthImage, survey: &Survey) {
 /// The mesh's triangles in order, coloured per vertex.
 fn water_surface(depth: &mut DepthImage, mesh: &Mesh, survey: &Survey) {
     let c = &survey.colouring;
-    let colour = |v: usize| -> Rgb {
-        match c.field {
-            ColorField::Speed => c.scalar(super::field::norm(mesh.velocity[v].map(f64::from))),
-            ColorField::Fluid => c.fluid(c.fluids.first().copied().unwrap_or(0)),
-            _ => colormap::WATER,
-        }
+    let widen = |a: &[f32; 3]| a.map(f64::from);
+    // A vertex with no velocity or normal (a damaged surface.h5) is drawn still and facing up
+    // rather than stopping the picture; a cell naming a missing vertex is left out.
+    let vertex = |v: u32| -> Option<Vertex> {
+        let v = v as usize;
+        let velocity = mesh.velocity.get(v).map_or([0.0; 3], widen);
+        Some(Vertex {
+            position: widen(mesh.positions.get(v)?),
+            normal: mesh.normals.get(v).map_or([0.0, 0.0, 1.0], widen),
+            colour: match c.field {
+                ColorField::Speed => c.scalar(super::field::norm(velocity)),
+                ColorField::Fluid => c.fluid(c.fluids.first().copied().unwrap_or(0)),
+                _ => colormap::WATER,
+            },
+        })
     };
     for cell in mesh.cells.chunks_exact(3) {
-        let vertex = |k: usize| {
-            let v = cell[k] as usize;
-            Vertex {
-                position: mesh.positions[v].map(f64::from),
-                normal: mesh.normals[v].map(f64::from),
-                colour: colour(v),
-            }
-        };
-        depth.triangle([vertex(0), vertex(1), vertex(2)]);
+        if let (Some(a), Some(b), Some(d)) = (vertex(cell[0]), vertex(cell[1]), vertex(cell[2])) {
+            depth.triangle([a, b, d]);
+        }
     }
 }
 

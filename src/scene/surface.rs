@@ -27,16 +27,18 @@ impl SurfaceKernel {
         }
     }
 
-    /// The kernel radius b, in particle spacings, unless one is given: a radius at which a
-    /// ball of 20 spacings' radius comes out within 1% of its volume and area
-    /// (docs/surface.md, "Kernels"). The Gaussian's a = 9/b² makes it the narrowest for its
-    /// radius, and it needs the widest; a wider kernel rounds corners and thins the surface
-    /// of a curved body more.
+    /// The kernel radius b, in particle spacings, unless one is given: the radius at which the
+    /// surface of a ball of 20 spacings' radius, its particles on a lattice, is smooth (normals
+    /// within 2.7° of the radius on the mean) and within 1.2% of the ball's volume
+    /// (docs/surface.md, "Kernels"). A narrower kernel shows each particle as a bump; a wider
+    /// one rounds corners and thins curved bodies more. The Gaussian's a = 9/b² makes it the
+    /// narrowest for its radius.
     pub fn default_radius(self) -> f64 {
         match self {
-            Self::Rectangular => 2.0,
-            Self::Quadric | Self::Quartic => 2.5,
-            Self::Gaussian => 4.0,
+            Self::Rectangular => 2.5,
+            Self::Quartic => 3.0,
+            Self::Quadric => 3.5,
+            Self::Gaussian => 5.0,
         }
     }
 

@@ -8,13 +8,15 @@
 //! vertices found in the owning block. Blocks, vertices and cells come out in one order
 //! whatever the thread count.
 
-use super::lattice::{BlockKey, Lattice};
+use super::lattice::{neighbourhood, BlockKey, Lattice};
 use super::table::Table;
 use rayon::prelude::*;
 
 /// The surface as extracted: vertices in block order, and the vertex numbers of its cells.
 pub struct Extracted<const D: usize> {
     pub positions: Vec<[f64; 3]>,
+    /// The outward unit normal at each vertex: against the density's gradient.
+    pub normals: Vec<[f32; 3]>,
     pub cells: Vec<u32>,
     /// The blocks that own vertices, with their first vertex (`vertex_starts` has one more
     /// entry, the vertex count).
@@ -27,31 +29,29 @@ pub struct Extracted<const D: usize> {
 struct Owned {
     edges: Vec<u32>,
     positions: Vec<[f64; 3]>,
+    normals: Vec<[f32; 3]>,
     crossed: bool,
 }
 
-/// The densities of a block's points and of the first points of the blocks after it: the
-/// corners of all its cubes. Axes beyond D hold one point.
+/// The densities of a block's points and of the points around it: the corners of all its cubes
+/// (points 0 to n along each axis) and one more point on each side, for the gradient at every
+/// corner. Axes beyond D hold one point.
 struct Corners {
     values: Vec<f32>,
-    /// Points along each axis (n + 1 for the first D, 1 beyond).
+    /// Points along each axis (n + 3 for the first D, 1 beyond).
     size: [usize; 3],
+    /// The first D axes start at point −1.
+    halo: [usize; 3],
 }
 
 impl Corners {
     fn of<const D: usize>(lattice: &Lattice<D>, values: &[Vec<f32>], key: &BlockKey<D>) -> Self {
-        let n = lattice.block;
-        let size: [usize; 3] = std::array::from_fn(|d| if d < D { n + 1 } else { 1 });
-        // The block itself and those after it along any set of axes.
-        let sources: Vec<Option<&[f32]>> = (0..1usize << D)
-            .map(|bits| {
-                let near: BlockKey<D> = std::array::from_fn(|d| key[d] + (bits >> d & 1) as i64);
-                lattice
-                    .valued
-                    .binary_search(&near)
-                    .ok()
-                    .map(|k| values[k].as_slice())
-            })
+        let n = lattice.block as i64;
+        let size: [usize; 3] = std::array::from_fn(|d| if d < D { n as usize + 3 } else { 1 });
+        let halo: [usize; 3] = std::array::from_fn(|d| (d < D) as usize);
+        // The blocks around this one, −1, 0 or +1 along each axis (digit d + 1 in base 3).
+        let sources: Vec<Option<&[f32]>> = neighbourhood(*key, -1..=1)
+            .map(|near| lattice.valued.binary_search(&near).ok().map(|k| values[k].as_slice()))
             .collect();
         let mut out = vec![0.0f32; size.iter().product()];
         let mut k = 0;
@@ -59,22 +59,43 @@ impl Corners {
             for y in 0..size[1] {
                 for x in 0..size[0] {
                     let l = [x, y, z];
-                    let (mut bits, mut local) = (0, 0);
-                    for d in (0..D).rev() {
-                        let wraps = l[d] == n;
-                        bits |= (wraps as usize) << d;
-                        local = local * n + if wraps { 0 } else { l[d] };
+                    let (mut source, mut local) = (0, 0);
+                    for d in 0..D {
+                        let p = l[d] as i64 - 1;
+                        let o = if p < 0 { -1 } else if p >= n { 1 } else { 0 };
+                        source = source * 3 + (o + 1) as usize;
                     }
-                    out[k] = sources[bits].map_or(0.0, |v| v[local]);
+                    for d in (0..D).rev() {
+                        let p = l[d] as i64 - 1;
+                        local = local * n + p.rem_euclid(n);
+                    }
+                    out[k] = sources[source].map_or(0.0, |v| v[local as usize]);
                     k += 1;
                 }
             }
         }
-        Self { values: out, size }
+        Self { values: out, size, halo }
     }
 
+    /// The density at block point `l` (0 to n along each axis).
     fn at(&self, l: [usize; 3]) -> f32 {
-        self.values[l[0] + self.size[0] * (l[1] + self.size[1] * l[2])]
+        let i: [usize; 3] = std::array::from_fn(|d| l[d] + self.halo[d]);
+        self.values[i[0] + self.size[0] * (i[1] + self.size[1] * i[2])]
+    }
+
+    /// The gradient of the density at block point `l` by central differences, per cube edge.
+    fn gradient<const D: usize>(&self, l: [usize; 3]) -> [f64; 3] {
+        std::array::from_fn(|d| {
+            if d >= D {
+                return 0.0;
+            }
+            let i: [usize; 3] = std::array::from_fn(|e| l[e] + self.halo[e]);
+            let (mut below, mut above) = (i, i);
+            below[d] -= 1;
+            above[d] += 1;
+            let index = |p: [usize; 3]| p[0] + self.size[0] * (p[1] + self.size[1] * p[2]);
+            (self.values[index(above)] - self.values[index(below)]) as f64 / 2.0
+        })
     }
 }
 
@@ -107,11 +128,11 @@ fn block_points<const D: usize>(n: usize) -> impl Iterator<Item = [usize; 3]> {
 fn owned_edges<const D: usize>(lattice: &Lattice<D>, corners: &Corners, key: &BlockKey<D>, iso: f32) -> Owned {
     let (n, h) = (lattice.block, lattice.edge);
     let first = lattice.first_point(key);
-    let (mut edges, mut positions) = (Vec::new(), Vec::new());
+    let (mut edges, mut positions, mut normals) = (Vec::new(), Vec::new(), Vec::new());
     let inside0 = corners.values[0] > iso;
     let crossed = corners.values.iter().any(|&v| (v > iso) != inside0);
     if !crossed {
-        return Owned { edges, positions, crossed };
+        return Owned { edges, positions, normals, crossed };
     }
     for l in block_points::<D>(n) {
         let v0 = corners.at(l);
@@ -128,10 +149,23 @@ fn owned_edges<const D: usize>(lattice: &Lattice<D>, corners: &Corners, key: &Bl
                 x[axis] += t * h;
                 edges.push((local_index::<D>(l, n) * D + axis) as u32);
                 positions.push(x);
+                normals.push(outward(corners.gradient::<D>(l), corners.gradient::<D>(m), t));
             }
         }
     }
-    Owned { edges, positions, crossed }
+    Owned { edges, positions, normals, crossed }
+}
+
+/// The outward unit normal where an edge from a point of density gradient `g0` to one of `g1`
+/// is crossed at fraction `t`: against the interpolated gradient (the density falls outward).
+fn outward(g0: [f64; 3], g1: [f64; 3], t: f64) -> [f32; 3] {
+    let g: [f64; 3] = std::array::from_fn(|d| -(g0[d] + t * (g1[d] - g0[d])));
+    let length = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    if length > 0.0 {
+        g.map(|c| (c / length) as f32)
+    } else {
+        [0.0; 3]
+    }
 }
 
 /// The cells of block `key`'s cubes, as global vertex numbers.
@@ -209,8 +243,10 @@ pub fn extract<const D: usize>(lattice: &Lattice<D>, values: &[Vec<f32>], table:
         })
         .collect();
     let positions = owned.iter().flat_map(|o| o.positions.iter().copied()).collect();
+    let normals = owned.iter().flat_map(|o| o.normals.iter().copied()).collect();
     Extracted {
         positions,
+        normals,
         cells: cells.concat(),
         blocks,
         vertex_starts,

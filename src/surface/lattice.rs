@@ -8,7 +8,8 @@ use crate::scene::CubeRule;
 /// Most cubes a reconstruction may span (over the particles' box padded by the kernel radius).
 pub const MAX_CUBES: f64 = 1.0e9;
 
-/// Cubes along a block's side: at least this many, and at least a kernel radius.
+/// Cubes along a block's side: a multiple of this many (the lanes of a row of the density
+/// sums), and at least a kernel radius.
 const MIN_BLOCK: usize = 8;
 
 /// A block's integer coordinates: it holds the lattice points `key × block + [0, block)ᴰ`.
@@ -83,7 +84,7 @@ pub fn cube_edge<const D: usize>(
 impl<const D: usize> Lattice<D> {
     /// The lattice of cube `edge` for `points` and a kernel of `radius`.
     pub fn of(points: &Points, edge: f64, radius: f64) -> Self {
-        let block = MIN_BLOCK.max((radius / edge).ceil() as usize);
+        let block = MIN_BLOCK * ((radius / edge) / MIN_BLOCK as f64).ceil().max(1.0) as usize;
         let side = block as f64 * edge;
         let key_of = |p: &[f64; 3]| -> BlockKey<D> {
             std::array::from_fn(|d| (p[d] / side).floor() as i64)

@@ -72,7 +72,6 @@ fn reconstruct_in<const D: usize>(
     let lattice = Lattice::<D>::of(points, edge, kernel.support);
     let values = density::sample(&lattice, points, &kernel);
     let surface = extract::extract(&lattice, &values, table, settings.iso);
-    let normals = attributes::normals(&surface.positions, &surface.cells, D);
     let velocity = attributes::velocities(
         &lattice,
         points,
@@ -84,7 +83,7 @@ fn reconstruct_in<const D: usize>(
     Ok(Mesh {
         dimensions: D,
         positions: surface.positions.iter().map(|p| p.map(|c| c as f32)).collect(),
-        normals,
+        normals: surface.normals,
         velocity,
         cells: surface.cells,
     })
