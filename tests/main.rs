@@ -27,5 +27,6 @@ mod simd;
 mod stability;
 mod study;
 mod surface;
+mod surface_runs;
 mod validation;
 mod wall_contact;
