@@ -3,6 +3,7 @@
 //! counts come from the arrays themselves (`Simulation::arrays`, `Particles::arrays_mut`), so
 //! the plan and the step cannot disagree.
 
+use crate::scene::{CubeRule, SurfaceSettings};
 use crate::scene::{Effects, Scene};
 use crate::simulation::{NoFluid, Simulation};
 use std::fmt;
@@ -29,6 +30,8 @@ pub struct Plan {
     pub smoothing_length: f64,
     pub wall_layers: usize,
     pub effects: Effects,
+    /// `[output.surface]`, built at every frame (None: particles only).
+    pub surface: Option<SurfaceSettings>,
     /// Per-particle bytes of the particle state (position, velocity, …).
     pub state_bytes_per_particle: usize,
     pub stages: Vec<PlannedStage>,
@@ -72,6 +75,7 @@ impl Plan {
             smoothing_length: scene.smoothing_length(),
             wall_layers: scene.wall_layers(),
             effects: scene.effects,
+            surface: scene.surface,
             state_bytes_per_particle: state.iter().map(|(_, a)| a.element_bytes()).sum(),
             stages,
         })
@@ -115,6 +119,22 @@ fn effects_line(e: &Effects) -> String {
     format!("{shifting}, {les}, {correction}")
 }
 
+/// What `[output.surface]` builds, as the plan says it.
+fn surface_line(s: &SurfaceSettings, dimensions: usize) -> String {
+    let cubes = match s.cubes {
+        CubeRule::Size(size) => format!("cubes of {size} dx"),
+        CubeRule::MaxCubes(n) => format!("at most {n} cubes over the fluid's box"),
+    };
+    let method = if dimensions == 3 { "marching cubes" } else { "marching squares" };
+    format!(
+        "surface by {method} at c = {} of the {} kernel's density (b = {} dx), {cubes}; surface.h5 + surface.xdmf, a PLY{} per frame in surface/ (a sparse lattice near the fluid, freed after each frame)",
+        s.iso,
+        s.kernel.name(),
+        s.radius,
+        if s.obj { " and an OBJ" } else { "" }
+    )
+}
+
 impl fmt::Display for Plan {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         let n = self.particles();
@@ -145,6 +165,9 @@ impl fmt::Display for Plan {
                 mib(s.bytes),
                 s.what
             )?;
+        }
+        if let Some(s) = &self.surface {
+            writeln!(f, "at every frame: {}", surface_line(s, self.dimensions))?;
         }
         write!(
             f,

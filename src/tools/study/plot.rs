@@ -72,6 +72,8 @@ fn log_range(values: impl Iterator<Item = f64> + Clone) -> std::ops::Range<f64> 
 }
 
 fn draw(path: &Path, title: &str, outcomes: &[Outcome]) -> Result<(), String> {
+    // plotters has no font of its own: the embedded one, as `isph render` draws with.
+    crate::render::font::register()?;
     let front = pareto(outcomes);
     let points: Vec<(f64, f64, &str, bool)> = outcomes
         .iter()
