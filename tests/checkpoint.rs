@@ -39,7 +39,7 @@ fn scene_file(
 /// 2D dam break at 2 dx: 40 steps to 16 output intervals.
 fn dam_break_2d(dir: &Path) -> PathBuf {
     let edits = [
-        ("spacing = 0.001905", "spacing = 0.00381"),
+        ("spacing = 0.00142875", "spacing = 0.00381"),
         ("output_interval = 0.01", "output_interval = 0.005"),
     ];
     scene_file(dir, "dam_break_2d.toml", &edits, 0.01, 3)
@@ -287,7 +287,7 @@ fn assert_refused(o: &Output, expected: &[&str]) {
 /// A short 2D run in `dir/base` whose checkpoints every run of the refusal test starts from.
 fn base_run(dir: &Path) -> PathBuf {
     let edits = [
-        ("spacing = 0.001905", "spacing = 0.00762"),
+        ("spacing = 0.00142875", "spacing = 0.00762"),
         ("output_interval = 0.01", "output_interval = 0.005"),
     ];
     let scene = scene_file(dir, "dam_break_2d.toml", &edits, 0.005, 3);
