@@ -128,9 +128,14 @@ fn bad_surface_requests_are_refused_and_nothing_is_overwritten() {
     let o = out.to_str().unwrap();
     let empty = dir.path().join("empty");
     std::fs::create_dir_all(&empty).unwrap();
+    // A run that has written its particles.h5 but no frame yet.
+    let no_frames = dir.path().join("no-frames");
+    std::fs::create_dir_all(&no_frames).unwrap();
+    drop(isph::io::frames::FrameWriter::create(&no_frames, 3, 0.02).unwrap());
     let png = dir.path().join("x.png");
     let cases: &[(&[&str], &[&str])] = &[
         (&["surface", empty.to_str().unwrap()], &["not a run's output directory", "particles.h5"]),
+        (&["surface", no_frames.to_str().unwrap()], &["particles.h5 holds no frames yet"]),
         (&["surface", o, "--frames", "7"], &["--frames 7", "frame 7 does not exist", "0 to 1"]),
         (&["surface", o, "--frames", "1..0"], &["runs backwards"]),
         (&["surface", o, "--cube-size", "0"], &["--cube-size", "positive"]),
@@ -161,4 +166,33 @@ fn bad_surface_requests_are_refused_and_nothing_is_overwritten() {
     let r = isph(&["run", path.to_str().unwrap(), "--out", dir.path().join("bad").to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&r.stderr);
     assert!(!r.status.success() && stderr.contains("output.surface.kernel") && stderr.contains("bad.toml:25"), "{stderr}");
+}
+
+#[test]
+fn the_surface_and_a_picture_of_a_run_still_going_can_be_made() {
+    let dir = TempDir::new("surface-live");
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, column_3d(10.0, "")).unwrap();
+    let out = dir.path().join("out");
+    let mut running = isph_command()
+        .args(["run", path.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q", "--threads", "1"])
+        .spawn()
+        .unwrap();
+    // The run holds particles.h5 open for writing, with HDF5's lock, until it ends.
+    let started = std::time::Instant::now();
+    let made = loop {
+        let o = isph(&["surface", out.to_str().unwrap(), "--frames", "1", "--out", dir.path().join("s").to_str().unwrap(), "--overwrite"]);
+        if o.status.success() || started.elapsed().as_secs() > 120 {
+            break o;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(200));
+    };
+    let png = dir.path().join("live.png");
+    let picture = isph(&["render", out.to_str().unwrap(), "--frame", "1", "-o", png.to_str().unwrap(), "--size", "320x200"]);
+    let still_running = running.try_wait().unwrap().is_none();
+    running.kill().unwrap();
+    running.wait().unwrap();
+    assert!(still_running, "the run ended before the test could read it");
+    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    assert!(picture.status.success(), "{}", String::from_utf8_lossy(&picture.stderr));
 }

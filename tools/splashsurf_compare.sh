@@ -12,17 +12,21 @@
 #   FRAME      frame number, or `last` [default: last]
 # Options:
 #   --threads N      threads of both tools [default: 2]
-#   --radius B       kernel support radius in particle spacings dx [default: 2.5, isph's own for
-#                    its quartic kernel]: isph `--kernel quartic --radius B`, splashsurf's cubic
-#                    spline with compact support B dx (`-l B` at `-r dx/2`)
+#   --radius B       kernel support radius in particle spacings dx [default: 3, isph's own for
+#                    its quartic kernel, docs/surface.md]: isph `--kernel quartic --radius B`,
+#                    splashsurf's cubic spline with compact support B dx (`-l B` at `-r dx/2`;
+#                    its README suggests -l 2, i.e. --radius 2)
 #   --cube-size C    marching-cubes edge in dx [default: 0.5]: isph `--cube-size C`, splashsurf
 #                    `-c 2C` (its cube size is in particle radii)
 #   --iso I          isph's iso-value of its density normalised to 1 inside [default: 0.5]
 #   --threshold T    splashsurf's surface threshold of its colour field [default: 0.6, its own]
-#   --repeats K      runs of each tool [default: 3]
+#   --repeats K      timed runs of each tool [default: 3]
+#   --warmup W       untimed runs of each tool first (file cache, page faults) [default: 1]
 #   --spacing DX     particle spacing of the frame the script makes [default: 0.02 m: 7,500 fluid
-#                    particles, ~2.5 min of simulation on 2 cores; 0.0125: ~31,000, ~15–20 min;
-#                    0.0085: ~1e5, an hour or more]
+#                    particles, 276 steps, 70 s of simulation on 2 idle cores (2.5 min beside a
+#                    compile); 0.0125: 30,720 particles; 0.0085: 97,000 particles, 696 steps, an
+#                    hour beside other work. At 7,500 particles each tool takes well under 0.1 s
+#                    and the times are mostly noise: use 0.0085 for a real comparison]
 #   --until T        simulated time of that frame [default: 0.4 s: the surge near the far wall]
 #   --work DIR       scratch directory [default: /tmp/isph_splashsurf_compare]
 # Environment: ISPH (isph binary; default: target/release/isph, built by `cargo build --release`),
@@ -47,17 +51,17 @@ cd "$ROOT"
 usage() { sed -n '2,/^set -euo/p' "$0" | sed -e '$d' -e 's/^# \{0,1\}//'; }
 die() { echo "splashsurf_compare: error: $*" >&2; exit 1; }
 
-RUN_DIR="" FRAME="last" THREADS=2 RADIUS=2.5 CUBE=0.5 ISO=0.5 THRESHOLD=0.6 REPEATS=3
+RUN_DIR="" FRAME="last" THREADS=2 RADIUS=3 CUBE=0.5 ISO=0.5 THRESHOLD=0.6 REPEATS=3 WARMUP=1
 SPACING=0.02 UNTIL=0.4 WORK=/tmp/isph_splashsurf_compare
 POSITIONAL=()
 while [ $# -gt 0 ]; do
   case "$1" in
     -h|--help) usage; exit 0 ;;
-    --threads|--radius|--cube-size|--iso|--threshold|--repeats|--spacing|--until|--work)
+    --threads|--radius|--cube-size|--iso|--threshold|--repeats|--warmup|--spacing|--until|--work)
       [ $# -ge 2 ] || die "$1 needs a value"
       case "$1" in
         --threads) THREADS=$2 ;; --radius) RADIUS=$2 ;; --cube-size) CUBE=$2 ;; --iso) ISO=$2 ;;
-        --threshold) THRESHOLD=$2 ;; --repeats) REPEATS=$2 ;; --spacing) SPACING=$2 ;;
+        --threshold) THRESHOLD=$2 ;; --repeats) REPEATS=$2 ;; --warmup) WARMUP=$2 ;; --spacing) SPACING=$2 ;;
         --until) UNTIL=$2 ;; --work) WORK=$2 ;;
       esac
       shift 2 ;;
@@ -72,6 +76,7 @@ done
 for v in THREADS REPEATS; do
   [[ "${!v}" =~ ^[1-9][0-9]*$ ]] || die "--$(echo "$v" | tr 'A-Z' 'a-z') must be a positive whole number"
 done
+[[ "$WARMUP" =~ ^[0-9]+$ ]] || die "--warmup must be a whole number"
 for v in RADIUS CUBE ISO THRESHOLD SPACING UNTIL; do
   [[ "${!v}" =~ ^[0-9]*\.?[0-9]+([eE][-+]?[0-9]+)?$ ]] || die "$v = ${!v} is not a number"
 done
@@ -153,6 +158,14 @@ SPLASH_CMD=("$SPLASH" reconstruct "$XYZ" -r "$R" -l "$RADIUS" -c "$C_SPLASH" -t 
             -n "$THREADS" -o "$SPLASH_PLY")
 
 now() { date +%s.%N; }
+for i in $(seq 1 "$WARMUP"); do
+  echo "== warm-up $i (untimed)"
+  RAYON_NUM_THREADS=$THREADS "${ISPH_CMD[@]}" > "$WORK/isph_warmup.log" 2>&1 \
+    || { cat "$WORK/isph_warmup.log" >&2; die "isph surface failed"; }
+  RAYON_NUM_THREADS=$THREADS "${SPLASH_CMD[@]}" > "$WORK/splashsurf_warmup.log" 2>&1 \
+    || { cat "$WORK/splashsurf_warmup.log" >&2; die "splashsurf reconstruct failed"; }
+done
+LOAD_BEFORE=$(cut -d' ' -f1-3 /proc/loadavg)
 ISPH_RECON="" ISPH_PROC="" SPLASH_RECON="" SPLASH_CORE="" SPLASH_PROC=""
 echo "== $REPEATS runs each on $THREADS threads, alternating; kernel support $SUPPORT m, cube $(calc "$CUBE * $P_spacing") m"
 for i in $(seq 1 "$REPEATS"); do
@@ -176,6 +189,10 @@ for i in $(seq 1 "$REPEATS"); do
   SPLASH_RECON+="$(calc "$total_ms / 1000") " SPLASH_CORE+="$(calc "$core_ms / 1000") " SPLASH_PROC+="$proc "
   echo "   splashsurf run $i: reconstruction $(printf %.3f "$(calc "$total_ms / 1000")") s (without reading and writing $(printf %.3f "$(calc "$core_ms / 1000")") s), process $(printf %.3f "$proc") s"
 done
+LOAD_AFTER=$(cut -d' ' -f1-3 /proc/loadavg)
+echo "   load average (1, 5, 15 min) before the timed runs: $LOAD_BEFORE, after: $LOAD_AFTER"
+BUSY=$(ps -eo pcpu=,comm= --sort=-pcpu | awk '$1 > 20 {printf "%s%s (%s%%)", sep, $2, $1; sep=", "}')
+[ -z "$BUSY" ] || echo "   warning: other processes busy now: $BUSY; the times may be disturbed"
 
 echo "== meshes"
 ISPH_MESH=$(python3 tools/surface_compare.py mesh "$ISPH_PLY")
@@ -195,6 +212,8 @@ RESULTS="$WORK/results.txt"
   echo "cube=$CUBE"
   echo "threads=$THREADS"
   echo "repeats=$REPEATS"
+  echo "warmup=$WARMUP"
+  echo "load=$LOAD_BEFORE before, $LOAD_AFTER after"
   echo "machine=$(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores"
   echo "splash_version=$SPLASH_VERSION"
   echo "isph_cmd=isph surface RUN --frames $P_frame --kernel quartic --radius $RADIUS --cube-size $CUBE --iso $ISO --threads $THREADS"

@@ -208,11 +208,11 @@ def report(path):
     print(f"# {kv['scene']}, frame {kv['frame']} (t = {kv['time']} s): {n} fluid particles, dx = {dx} m, "
           f"N·dx³ = {fluid:.6e} m³")
     print(f"# kernel support {kv['radius']} dx = {float(kv['radius']) * dx:g} m, cube {kv['cube']} dx = "
-          f"{float(kv['cube']) * dx:g} m, {kv['threads']} threads, {kv['repeats']} runs each, alternating; "
-          f"times: median (min–max) in s")
+          f"{float(kv['cube']) * dx:g} m, {kv['threads']} threads, {kv['repeats']} timed runs each, alternating, "
+          f"after {kv.get('warmup', 0)} untimed; times: median (min–max) in s")
     print(f"# isph: {kv['isph_cmd']}")
     print(f"# splashsurf {kv['splash_version']}: {kv['splash_cmd']}")
-    print(f"# machine: {kv['machine']}")
+    print(f"# machine: {kv['machine']}; load average (1, 5, 15 min): {kv.get('load', '?')}")
     cols = ["tool", "settings", "recon_s", "process_s", "triangles", "vertices", "pieces",
             "volume_m3", "volume/N·dx³", "area_m2", "closed"]
     rows = []

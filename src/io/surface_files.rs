@@ -213,10 +213,14 @@ impl SurfaceReader {
         if !path.exists() {
             return Ok(None);
         }
-        let file = hdf5::File::open(&path).map_err(|source| OutputError::Hdf5Read {
-            path: path.clone(),
-            source,
-        })?;
+        // Without HDF5's file lock, as `FrameReader::open`: a run may be writing it.
+        let file = hdf5::File::with_options()
+            .with_fapl(|p| p.file_locking(false))
+            .open(&path)
+            .map_err(|source| OutputError::Hdf5Read {
+                path: path.clone(),
+                source,
+            })?;
         Ok(Some(Self { file, path }))
     }
 
