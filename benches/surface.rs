@@ -16,7 +16,9 @@ pub fn wavy_water(n: usize) -> Points {
     let side = (2.0 * n as f64).cbrt().round() as i64;
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut jitter = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.2 * dx
     };
     let mut position = Vec::new();
@@ -31,7 +33,9 @@ pub fn wavy_water(n: usize) -> Points {
                 k += 1;
             }
             if (i * side + j) % 40 == 0 {
-                for (a, b, c) in (-5i64..=5).flat_map(|a| (-5i64..=5).flat_map(move |b| (-5i64..=5).map(move |c| (a, b, c)))) {
+                for (a, b, c) in (-5i64..=5).flat_map(|a| {
+                    (-5i64..=5).flat_map(move |b| (-5i64..=5).map(move |c| (a, b, c)))
+                }) {
                     if a * a + b * b + c * c <= 25 {
                         let z = depth + 0.15 * s;
                         position.push([x + a as f64 * dx, y + b as f64 * dx, z + c as f64 * dx]);
@@ -50,14 +54,17 @@ pub fn wavy_water(n: usize) -> Points {
 
 fn reconstruction(c: &mut Criterion) {
     let mut group = c.benchmark_group("surface");
-    group.sample_size(10).measurement_time(Duration::from_secs(20));
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(20));
     let settings = SurfaceSettings::default();
     for n in [100_000, 1_000_000] {
         let points = wavy_water(n);
         group.throughput(Throughput::Elements(points.position.len() as u64));
-        group.bench_function(format!("reconstruct {} particles", points.position.len()), |b| {
-            b.iter(|| reconstruct(&points, &settings).unwrap())
-        });
+        group.bench_function(
+            format!("reconstruct {} particles", points.position.len()),
+            |b| b.iter(|| reconstruct(&points, &settings).unwrap()),
+        );
     }
     group.finish();
 }

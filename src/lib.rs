@@ -25,8 +25,8 @@ pub mod scene;
 pub mod simulation;
 pub mod solver;
 pub mod sph;
-pub mod surface;
 pub(crate) mod step;
+pub mod surface;
 pub mod tools;
 
 // The facade: what the command line (`main.rs`) and a program driving isph use.

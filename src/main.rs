@@ -3,9 +3,9 @@
 use anyhow::{bail, Context};
 use clap::{Parser, Subcommand};
 use isph::bench::{self, BenchOptions, Schedule};
-use isph::resume::{self, ResumeOptions};
 use isph::io::surface_files;
 use isph::render::{self, ColorField, FrameChoice, RenderOptions};
+use isph::resume::{self, ResumeOptions};
 use isph::scene::SurfaceRequest;
 use isph::study::{plot, StudyOptions};
 use isph::tools::surface::{surface_run, SurfaceOptions};
@@ -387,10 +387,14 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         } => {
             start_threads(threads)?;
             let color = ColorField::from_name(&color).ok_or_else(|| {
-                anyhow::anyhow!("--color {color}: not a field; one of {}", ColorField::NAMES.join(", "))
+                anyhow::anyhow!(
+                    "--color {color}: not a field; one of {}",
+                    ColorField::NAMES.join(", ")
+                )
             })?;
-            let size = render::parse_size(&size)
-                .ok_or_else(|| anyhow::anyhow!("--size {size}: give WIDTHxHEIGHT in pixels, e.g. 1920x1080"))?;
+            let size = render::parse_size(&size).ok_or_else(|| {
+                anyhow::anyhow!("--size {size}: give WIDTHxHEIGHT in pixels, e.g. 1920x1080")
+            })?;
             let frames = match (frame, all) {
                 (Some(k), _) => FrameChoice::One(k),
                 (None, true) => FrameChoice::All,
@@ -405,7 +409,11 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let written = render::render_run(&run, &opts)?;
             match written.as_slice() {
                 [one] => outln!("written: {}", one.display()),
-                many => outln!("written: {} pictures in {}", many.len(), opts.output.display()),
+                many => outln!(
+                    "written: {} pictures in {}",
+                    many.len(),
+                    opts.output.display()
+                ),
             }
             Ok(())
         }

@@ -75,7 +75,9 @@ impl FrameWriter {
             file.new_attr::<u64>()
                 .create("dimensions")?
                 .write_scalar(&(dimensions as u64))?;
-            file.new_attr::<f64>().create("spacing")?.write_scalar(&spacing)
+            file.new_attr::<f64>()
+                .create("spacing")?
+                .write_scalar(&spacing)
         };
         describe().map_err(hdf5_error)?;
         Ok(Self { file, path })
@@ -231,7 +233,9 @@ pub struct Frame {
 impl Frame {
     /// The frame's fluid particles (kind 0), for a surface: a run of `dimensions` at `spacing`.
     pub fn fluid_points(&self, dimensions: usize, spacing: f64) -> Points {
-        let fluid: Vec<usize> = (0..self.kind.len()).filter(|&i| self.kind[i] == 0).collect();
+        let fluid: Vec<usize> = (0..self.kind.len())
+            .filter(|&i| self.kind[i] == 0)
+            .collect();
         Points {
             dimensions,
             spacing,
@@ -277,7 +281,10 @@ impl FrameReader {
     pub fn geometry(&self) -> Result<(usize, f64), OutputError> {
         let read = || -> hdf5::Result<(usize, f64)> {
             let dimensions: u64 = self.file.attr("dimensions")?.read_scalar()?;
-            Ok((dimensions as usize, self.file.attr("spacing")?.read_scalar()?))
+            Ok((
+                dimensions as usize,
+                self.file.attr("spacing")?.read_scalar()?,
+            ))
         };
         read().map_err(|_| OutputError::Malformed {
             path: self.path.clone(),

@@ -73,7 +73,9 @@ impl SurfaceWriter {
         let mut names = file.member_names().map_err(hdf5_error)?;
         names.sort();
         for name in names {
-            let Some(frame) = frame_of(&name) else { continue };
+            let Some(frame) = frame_of(&name) else {
+                continue;
+            };
             if frame >= first {
                 file.unlink(&name).map_err(hdf5_error)?;
             } else {
@@ -93,10 +95,18 @@ impl SurfaceWriter {
 
     /// Appends the surface of particle frame `frame` at `time`, rewrites the index, and writes
     /// its PLY file (and OBJ file if `obj`).
-    pub fn write(&mut self, frame: usize, time: f64, mesh: &Mesh, obj: bool) -> Result<SurfaceInfo, OutputError> {
-        write_group(&self.file, &group_name(frame), time, mesh).map_err(|source| OutputError::Hdf5 {
-            path: self.path.clone(),
-            source,
+    pub fn write(
+        &mut self,
+        frame: usize,
+        time: f64,
+        mesh: &Mesh,
+        obj: bool,
+    ) -> Result<SurfaceInfo, OutputError> {
+        write_group(&self.file, &group_name(frame), time, mesh).map_err(|source| {
+            OutputError::Hdf5 {
+                path: self.path.clone(),
+                source,
+            }
         })?;
         let info = SurfaceInfo {
             frame,
@@ -112,9 +122,17 @@ impl SurfaceWriter {
             path: meshes.clone(),
             source,
         })?;
-        write_ply(&meshes.join(format!("{}.ply", group_name(frame))), mesh, time)?;
+        write_ply(
+            &meshes.join(format!("{}.ply", group_name(frame))),
+            mesh,
+            time,
+        )?;
         if obj {
-            write_obj(&meshes.join(format!("{}.obj", group_name(frame))), mesh, time)?;
+            write_obj(
+                &meshes.join(format!("{}.obj", group_name(frame))),
+                mesh,
+                time,
+            )?;
         }
         Ok(info)
     }
@@ -149,7 +167,11 @@ fn write_group(file: &hdf5::File, name: &str, time: f64, mesh: &Mesh) -> hdf5::R
     }
     let g = file.create_group(name)?;
     let v = mesh.vertex_count();
-    for (field, data) in [("position", &mesh.positions), ("normal", &mesh.normals), ("velocity", &mesh.velocity)] {
+    for (field, data) in [
+        ("position", &mesh.positions),
+        ("normal", &mesh.normals),
+        ("velocity", &mesh.velocity),
+    ] {
         g.new_dataset::<f32>()
             .shape((v, 3))
             .create(field)?
@@ -171,7 +193,11 @@ pub fn index_document(surfaces: &[SurfaceInfo]) -> String {
     );
     for s in surfaces.iter().filter(|s| s.cells > 0) {
         let g = group_name(s.frame);
-        let (topology, per) = if s.dimensions == 3 { ("Triangle", 3) } else { ("Polyline", 2) };
+        let (topology, per) = if s.dimensions == 3 {
+            ("Triangle", 3)
+        } else {
+            ("Polyline", 2)
+        };
         let item = |name: &str, columns: usize, number: &str| {
             format!(
                 "<DataItem Dimensions=\"{} {columns}\" NumberType=\"{number}\" Precision=\"4\" Format=\"HDF\">{FILE_NAME}:/{g}/{name}</DataItem>",
@@ -186,7 +212,11 @@ pub fn index_document(surfaces: &[SurfaceInfo]) -> String {
             s.cells,
             item("cells", per, "UInt")
         );
-        let _ = writeln!(x, "    <Geometry GeometryType=\"XYZ\">{}</Geometry>", item("position", 3, "Float"));
+        let _ = writeln!(
+            x,
+            "    <Geometry GeometryType=\"XYZ\">{}</Geometry>",
+            item("position", 3, "Float")
+        );
         for name in ["normal", "velocity"] {
             let _ = writeln!(
                 x,
@@ -263,14 +293,26 @@ pub fn write_ply(path: &Path, mesh: &Mesh, time: f64) -> Result<(), OutputError>
         let _ = writeln!(header, "property float {p}");
     }
     if mesh.dimensions == 3 {
-        let _ = writeln!(header, "element face {}\nproperty list uchar int vertex_indices", mesh.cell_count());
+        let _ = writeln!(
+            header,
+            "element face {}\nproperty list uchar int vertex_indices",
+            mesh.cell_count()
+        );
     } else {
-        let _ = writeln!(header, "element edge {}\nproperty int vertex1\nproperty int vertex2", mesh.cell_count());
+        let _ = writeln!(
+            header,
+            "element edge {}\nproperty int vertex1\nproperty int vertex2",
+            mesh.cell_count()
+        );
     }
     header.push_str("end_header\n");
     let mut bytes = header.into_bytes();
     for v in 0..mesh.vertex_count() {
-        for c in mesh.positions[v].iter().chain(&mesh.normals[v]).chain(&mesh.velocity[v]) {
+        for c in mesh.positions[v]
+            .iter()
+            .chain(&mesh.normals[v])
+            .chain(&mesh.velocity[v])
+        {
             bytes.extend_from_slice(&c.to_le_bytes());
         }
     }
@@ -289,7 +331,11 @@ pub fn write_ply(path: &Path, mesh: &Mesh, time: f64) -> Result<(), OutputError>
 pub fn write_obj(path: &Path, mesh: &Mesh, time: f64) -> Result<(), OutputError> {
     let mut text = format!("# isph surface at t = {time} s\n");
     for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
-        let _ = writeln!(text, "v {} {} {}\nvn {} {} {}", p[0], p[1], p[2], n[0], n[1], n[2]);
+        let _ = writeln!(
+            text,
+            "v {} {} {}\nvn {} {} {}",
+            p[0], p[1], p[2], n[0], n[1], n[2]
+        );
     }
     for cell in mesh.cells.chunks_exact(mesh.vertices_per_cell()) {
         if mesh.dimensions == 3 {

@@ -300,7 +300,10 @@ impl<'a, const D: usize> Driver<'a, D> {
                 Ok(mesh) => {
                     writer.write(index, self.sim.time, &mesh, settings.obj)?;
                 }
-                Err(e) => eprintln!("warning: frame {index} (t = {} s) has no surface: {e}", self.sim.time),
+                Err(e) => eprintln!(
+                    "warning: frame {index} (t = {} s) has no surface: {e}",
+                    self.sim.time
+                ),
             }
         }
         o.stats.flush()?;

@@ -21,8 +21,15 @@ pub(crate) struct Output {
 /// The fluid particles of `p` in id order, as a frame lists them: the surface built during a
 /// run is the one `isph surface` builds from its frame.
 pub(crate) fn fluid_points<const D: usize>(p: &Particles<D>, spacing: f64) -> Points {
-    let fluid: Vec<usize> = p.index_by_id().into_iter().map(|i| i as usize).filter(|&i| p.is_fluid(i)).collect();
-    let triple = |c: &[Vec<f64>; D], i: usize| -> [f64; 3] { std::array::from_fn(|d| if d < D { c[d][i] } else { 0.0 }) };
+    let fluid: Vec<usize> = p
+        .index_by_id()
+        .into_iter()
+        .map(|i| i as usize)
+        .filter(|&i| p.is_fluid(i))
+        .collect();
+    let triple = |c: &[Vec<f64>; D], i: usize| -> [f64; 3] {
+        std::array::from_fn(|d| if d < D { c[d][i] } else { 0.0 })
+    };
     Points {
         dimensions: D,
         spacing,

@@ -109,20 +109,32 @@ impl SurfaceRequest {
             Some(name) => SurfaceKernel::from_name(name).ok_or_else(|| {
                 (
                     "kernel",
-                    format!("= \"{name}\" is not a kernel: one of {}", SurfaceKernel::NAMES.join(", ")),
+                    format!(
+                        "= \"{name}\" is not a kernel: one of {}",
+                        SurfaceKernel::NAMES.join(", ")
+                    ),
                 )
             })?,
         };
         let radius = self.radius.unwrap_or(kernel.default_radius());
-        if !(radius.is_finite() && radius >= 0.5 && radius <= 20.0) {
-            return Err(("radius", format!("= {radius:?} must lie in [0.5, 20] particle spacings")));
+        if !(0.5..=20.0).contains(&radius) {
+            return Err((
+                "radius",
+                format!("= {radius:?} must lie in [0.5, 20] particle spacings"),
+            ));
         }
         let cubes = match (self.cube_size, self.max_cubes) {
             (Some(_), Some(_)) => {
-                return Err(("cube_size", "and max_cubes both choose the cube size: give one".into()))
+                return Err((
+                    "cube_size",
+                    "and max_cubes both choose the cube size: give one".into(),
+                ))
             }
             (Some(size), None) if !(size.is_finite() && size > 0.0) => {
-                return Err(("cube_size", format!("= {size:?} must be a positive number of particle spacings")))
+                return Err((
+                    "cube_size",
+                    format!("= {size:?} must be a positive number of particle spacings"),
+                ))
             }
             (Some(size), None) => CubeRule::Size(size),
             (None, Some(n)) if n < 1 => {

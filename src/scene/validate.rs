@@ -248,7 +248,12 @@ impl Validator<'_> {
             .transpose()?;
         let checkpoint = self.checkpoint(&f.checkpoint)?;
         let effects = self.effects(&f.effects)?;
-        let surface = f.output.surface.as_ref().map(|s| self.surface(s)).transpose()?;
+        let surface = f
+            .output
+            .surface
+            .as_ref()
+            .map(|s| self.surface(s))
+            .transpose()?;
 
         let name = match &s.name {
             Some(n) => {

@@ -18,7 +18,17 @@ pub fn velocities<const D: usize>(
     blocks: &[BlockKey<D>],
     vertex_starts: &[usize],
 ) -> Vec<[f32; 3]> {
-    kernel.with_profile(1.0, Interpolation { lattice, points, support: kernel.support, positions, blocks, vertex_starts })
+    kernel.with_profile(
+        1.0,
+        Interpolation {
+            lattice,
+            points,
+            support: kernel.support,
+            positions,
+            blocks,
+            vertex_starts,
+        },
+    )
 }
 
 struct Interpolation<'a, const D: usize> {
@@ -34,7 +44,14 @@ impl<const D: usize> ProfileVisitor for Interpolation<'_, D> {
     type Output = Vec<[f32; 3]>;
 
     fn visit<P: Profile>(self, profile: P) -> Vec<[f32; 3]> {
-        let Self { lattice, points, support, positions, blocks, vertex_starts } = self;
+        let Self {
+            lattice,
+            points,
+            support,
+            positions,
+            blocks,
+            vertex_starts,
+        } = self;
         blocks
             .par_iter()
             .enumerate()
@@ -44,7 +61,10 @@ impl<const D: usize> ProfileVisitor for Interpolation<'_, D> {
                     return Vec::new();
                 }
                 let bins = Bins::of(lattice, points, support, key);
-                positions[range].iter().map(|x| bins.velocity_at(x, &profile)).collect()
+                positions[range]
+                    .iter()
+                    .map(|x| bins.velocity_at(x, &profile))
+                    .collect()
             })
             .collect()
     }
@@ -65,13 +85,28 @@ struct Bins<const D: usize> {
 impl<const D: usize> Bins<D> {
     fn of(lattice: &Lattice<D>, points: &Points, support: f64, key: &BlockKey<D>) -> Self {
         let side = lattice.block as f64 * lattice.edge;
-        let origin: [f64; 3] = std::array::from_fn(|d| if d < D { key[d] as f64 * side - support } else { 0.0 });
-        let size: [usize; 3] =
-            std::array::from_fn(|d| if d < D { ((side + 2.0 * support) / support).ceil() as usize } else { 1 });
+        let origin: [f64; 3] = std::array::from_fn(|d| {
+            if d < D {
+                key[d] as f64 * side - support
+            } else {
+                0.0
+            }
+        });
+        let size: [usize; 3] = std::array::from_fn(|d| {
+            if d < D {
+                ((side + 2.0 * support) / support).ceil() as usize
+            } else {
+                1
+            }
+        });
         let cell_of = |x: &[f64; 3]| -> Option<usize> {
             let mut c = 0;
             for d in (0..3).rev() {
-                let k = if d < D { ((x[d] - origin[d]) / support).floor() } else { 0.0 };
+                let k = if d < D {
+                    ((x[d] - origin[d]) / support).floor()
+                } else {
+                    0.0
+                };
                 if k < 0.0 || k >= size[d] as f64 {
                     return None;
                 }
@@ -92,26 +127,40 @@ impl<const D: usize> Bins<D> {
         for c in 0..cells {
             starts[c + 1] += starts[c];
         }
-        let column = |f: &dyn Fn(usize) -> f32| -> Vec<f32> { near.iter().map(|&(_, i)| f(i as usize)).collect() };
+        let column = |f: &dyn Fn(usize) -> f32| -> Vec<f32> {
+            near.iter().map(|&(_, i)| f(i as usize)).collect()
+        };
         Self {
             origin,
             cell: support,
             size,
             starts,
-            position: std::array::from_fn(|d| column(&|i| (points.position[i][d] - origin[d]) as f32)),
+            position: std::array::from_fn(|d| {
+                column(&|i| (points.position[i][d] - origin[d]) as f32)
+            }),
             velocity: std::array::from_fn(|d| column(&|i| points.velocity[i][d] as f32)),
         }
     }
 
     fn velocity_at<P: Profile>(&self, x: &[f64; 3], profile: &P) -> [f32; 3] {
         let local: [f64; 3] = std::array::from_fn(|d| x[d] - self.origin[d]);
-        let centre: [i64; 3] = std::array::from_fn(|d| if d < D { (local[d] / self.cell).floor() as i64 } else { 0 });
+        let centre: [i64; 3] = std::array::from_fn(|d| {
+            if d < D {
+                (local[d] / self.cell).floor() as i64
+            } else {
+                0
+            }
+        });
         let x32 = local.map(|c| c as f32);
         let (mut weight, mut sum) = (0.0f32, [0.0f32; 3]);
         let reach: [i64; 3] = std::array::from_fn(|d| (d < D) as i64);
         let clamp = |d: usize, c: i64| c.clamp(0, self.size[d] as i64 - 1) as usize;
-        for cz in (centre[2] - reach[2]).max(0)..=(centre[2] + reach[2]).min(self.size[2] as i64 - 1) {
-            for cy in (centre[1] - reach[1]).max(0)..=(centre[1] + reach[1]).min(self.size[1] as i64 - 1) {
+        for cz in
+            (centre[2] - reach[2]).max(0)..=(centre[2] + reach[2]).min(self.size[2] as i64 - 1)
+        {
+            for cy in
+                (centre[1] - reach[1]).max(0)..=(centre[1] + reach[1]).min(self.size[1] as i64 - 1)
+            {
                 // The row of cells along x around the vertex: one run of particles.
                 let row = (cz as usize * self.size[1] + cy as usize) * self.size[0];
                 let first = self.starts[row + clamp(0, centre[0] - 1)];

@@ -12,9 +12,20 @@ use rayon::prelude::*;
 /// V_i is the particle's rest volume dx^D: the summation density written with a frame falls
 /// at the free surface because the kernel there is cut off, not because the fluid expands, and
 /// dividing by it would swell every surface particle.
-pub fn sample<const D: usize>(lattice: &Lattice<D>, points: &Points, kernel: &Kernel) -> Vec<Vec<f32>> {
+pub fn sample<const D: usize>(
+    lattice: &Lattice<D>,
+    points: &Points,
+    kernel: &Kernel,
+) -> Vec<Vec<f32>> {
     let volume = points.spacing.powi(D as i32);
-    kernel.with_profile(volume, Sampler { lattice, points, support: kernel.support })
+    kernel.with_profile(
+        volume,
+        Sampler {
+            lattice,
+            points,
+            support: kernel.support,
+        },
+    )
 }
 
 struct Sampler<'a, const D: usize> {
@@ -27,10 +38,18 @@ impl<const D: usize> ProfileVisitor for Sampler<'_, D> {
     type Output = Vec<Vec<f32>>;
 
     fn visit<P: Profile>(self, profile: P) -> Vec<Vec<f32>> {
-        let Self { lattice, points, support } = self;
+        let Self {
+            lattice,
+            points,
+            support,
+        } = self;
         // Positions and support in cube edges, computed once: a particle is visited by the
         // 3ᴰ blocks around its own.
-        let scaled: Vec<[f64; 3]> = points.position.iter().map(|x| x.map(|c| c / lattice.edge)).collect();
+        let scaled: Vec<[f64; 3]> = points
+            .position
+            .iter()
+            .map(|x| x.map(|c| c / lattice.edge))
+            .collect();
         let reach = support / lattice.edge;
         lattice
             .valued
@@ -42,7 +61,15 @@ impl<const D: usize> ProfileVisitor for Sampler<'_, D> {
                 for near in neighbourhood(*key, -1..=1) {
                     for &i in lattice.particles_in(&near) {
                         let x = &scaled[i as usize];
-                        scatter(lattice, &first, x, reach, &profile, &mut squared, &mut values);
+                        scatter(
+                            lattice,
+                            &first,
+                            x,
+                            reach,
+                            &profile,
+                            &mut squared,
+                            &mut values,
+                        );
                     }
                 }
                 values
@@ -84,7 +111,11 @@ fn scatter<const D: usize, P: Profile>(
         // to its last bits.
         let offset = (x[d] - first[d] as f64) as f32;
         let h = h as f32;
-        let (from, to) = if d == 0 { (0, n as usize - 1) } else { range[d] };
+        let (from, to) = if d == 0 {
+            (0, n as usize - 1)
+        } else {
+            range[d]
+        };
         for l in from..=to {
             let r = (l as f32 - offset) * h;
             squared[d][l] = r * r;

@@ -51,7 +51,13 @@ impl Corners {
         let halo: [usize; 3] = std::array::from_fn(|d| (d < D) as usize);
         // The blocks around this one, −1, 0 or +1 along each axis (digit d + 1 in base 3).
         let sources: Vec<Option<&[f32]>> = neighbourhood(*key, -1..=1)
-            .map(|near| lattice.valued.binary_search(&near).ok().map(|k| values[k].as_slice()))
+            .map(|near| {
+                lattice
+                    .valued
+                    .binary_search(&near)
+                    .ok()
+                    .map(|k| values[k].as_slice())
+            })
             .collect();
         let mut out = vec![0.0f32; size.iter().product()];
         let mut k = 0;
@@ -62,7 +68,13 @@ impl Corners {
                     let (mut source, mut local) = (0, 0);
                     for d in 0..D {
                         let p = l[d] as i64 - 1;
-                        let o = if p < 0 { -1 } else if p >= n { 1 } else { 0 };
+                        let o = if p < 0 {
+                            -1
+                        } else if p >= n {
+                            1
+                        } else {
+                            0
+                        };
                         source = source * 3 + (o + 1) as usize;
                     }
                     for d in (0..D).rev() {
@@ -74,7 +86,11 @@ impl Corners {
                 }
             }
         }
-        Self { values: out, size, halo }
+        Self {
+            values: out,
+            size,
+            halo,
+        }
     }
 
     /// The density at block point `l` (0 to n along each axis).
@@ -106,7 +122,8 @@ fn marching_blocks<const D: usize>(lattice: &Lattice<D>) -> Vec<BlockKey<D>> {
         .valued
         .iter()
         .flat_map(|key| {
-            (0..1usize << D).map(move |bits| std::array::from_fn(|d| key[d] - (bits >> d & 1) as i64))
+            (0..1usize << D)
+                .map(move |bits| std::array::from_fn(|d| key[d] - (bits >> d & 1) as i64))
         })
         .collect();
     keys.sort_unstable();
@@ -122,17 +139,28 @@ fn local_index<const D: usize>(l: [usize; 3], n: usize) -> usize {
 /// Every point of a block (or its cubes' first corners), x fastest.
 fn block_points<const D: usize>(n: usize) -> impl Iterator<Item = [usize; 3]> {
     let size: [usize; 3] = std::array::from_fn(|d| if d < D { n } else { 1 });
-    (0..size[2]).flat_map(move |z| (0..size[1]).flat_map(move |y| (0..size[0]).map(move |x| [x, y, z])))
+    (0..size[2])
+        .flat_map(move |z| (0..size[1]).flat_map(move |y| (0..size[0]).map(move |x| [x, y, z])))
 }
 
-fn owned_edges<const D: usize>(lattice: &Lattice<D>, corners: &Corners, key: &BlockKey<D>, iso: f32) -> Owned {
+fn owned_edges<const D: usize>(
+    lattice: &Lattice<D>,
+    corners: &Corners,
+    key: &BlockKey<D>,
+    iso: f32,
+) -> Owned {
     let (n, h) = (lattice.block, lattice.edge);
     let first = lattice.first_point(key);
     let (mut edges, mut positions, mut normals) = (Vec::new(), Vec::new(), Vec::new());
     let inside0 = corners.values[0] > iso;
     let crossed = corners.values.iter().any(|&v| (v > iso) != inside0);
     if !crossed {
-        return Owned { edges, positions, normals, crossed };
+        return Owned {
+            edges,
+            positions,
+            normals,
+            crossed,
+        };
     }
     for l in block_points::<D>(n) {
         let v0 = corners.at(l);
@@ -149,11 +177,20 @@ fn owned_edges<const D: usize>(lattice: &Lattice<D>, corners: &Corners, key: &Bl
                 x[axis] += t * h;
                 edges.push((local_index::<D>(l, n) * D + axis) as u32);
                 positions.push(x);
-                normals.push(outward(corners.gradient::<D>(l), corners.gradient::<D>(m), t));
+                normals.push(outward(
+                    corners.gradient::<D>(l),
+                    corners.gradient::<D>(m),
+                    t,
+                ));
             }
         }
     }
-    Owned { edges, positions, normals, crossed }
+    Owned {
+        edges,
+        positions,
+        normals,
+        crossed,
+    }
 }
 
 /// The outward unit normal where an edge from a point of density gradient `g0` to one of `g1`
@@ -168,6 +205,31 @@ fn outward(g0: [f64; 3], g1: [f64; 3], t: f64) -> [f32; 3] {
     }
 }
 
+/// Where each block's vertices are: the marching blocks, the edges each owns, and the number
+/// of its first vertex.
+struct Owners<'a, const D: usize> {
+    blocks: &'a [BlockKey<D>],
+    owned: &'a [Owned],
+    vertex_starts: &'a [usize],
+}
+
+impl<const D: usize> Owners<'_, D> {
+    /// The vertex on edge `id` (`point × D + axis`) of block `key`.
+    fn vertex(&self, key: &BlockKey<D>, id: u32) -> u32 {
+        // The owner holds this edge: one of its ends is inside, so the owner is a valued
+        // block or one just before a valued block, a marching block either way.
+        let b = self
+            .blocks
+            .binary_search(key)
+            .expect("the owner of a crossed edge is a marching block");
+        let k = self.owned[b]
+            .edges
+            .binary_search(&id)
+            .expect("a crossed edge has a vertex");
+        (self.vertex_starts[b] + k) as u32
+    }
+}
+
 /// The cells of block `key`'s cubes, as global vertex numbers.
 fn block_cells<const D: usize>(
     lattice: &Lattice<D>,
@@ -175,9 +237,7 @@ fn block_cells<const D: usize>(
     key: &BlockKey<D>,
     table: &Table<D>,
     iso: f32,
-    blocks: &[BlockKey<D>],
-    owned: &[Owned],
-    vertex_starts: &[usize],
+    owners: &Owners<D>,
 ) -> Vec<u32> {
     let n = lattice.block;
     let mut cells = Vec::new();
@@ -191,12 +251,7 @@ fn block_cells<const D: usize>(
                 near[d] += 1;
             }
         }
-        // The owner holds this edge: one of its ends is inside, so the owner is a valued
-        // block or one just before a valued block, a marching block either way.
-        let b = blocks.binary_search(&near).expect("the owner of a crossed edge is a marching block");
-        let id = (local_index::<D>(q, n) * D + axis) as u32;
-        let k = owned[b].edges.binary_search(&id).expect("a crossed edge has a vertex");
-        (vertex_starts[b] + k) as u32
+        owners.vertex(&near, (local_index::<D>(q, n) * D + axis) as u32)
     };
     for l in block_points::<D>(n) {
         let mut case = 0;
@@ -217,7 +272,12 @@ fn block_cells<const D: usize>(
 }
 
 /// The iso-surface c = `iso` of the density `values` (one per `lattice.valued` block).
-pub fn extract<const D: usize>(lattice: &Lattice<D>, values: &[Vec<f32>], table: &Table<D>, iso: f64) -> Extracted<D> {
+pub fn extract<const D: usize>(
+    lattice: &Lattice<D>,
+    values: &[Vec<f32>],
+    table: &Table<D>,
+    iso: f64,
+) -> Extracted<D> {
     let iso = iso as f32;
     let blocks = marching_blocks(lattice);
     let owned: Vec<Owned> = blocks
@@ -231,6 +291,11 @@ pub fn extract<const D: usize>(lattice: &Lattice<D>, values: &[Vec<f32>], table:
         total += o.edges.len();
     }
     vertex_starts.push(total);
+    let owners = Owners {
+        blocks: &blocks,
+        owned: &owned,
+        vertex_starts: &vertex_starts,
+    };
     let cells: Vec<Vec<u32>> = blocks
         .par_iter()
         .zip(&owned)
@@ -239,11 +304,17 @@ pub fn extract<const D: usize>(lattice: &Lattice<D>, values: &[Vec<f32>], table:
                 return Vec::new();
             }
             let corners = Corners::of(lattice, values, key);
-            block_cells(lattice, &corners, key, table, iso, &blocks, &owned, &vertex_starts)
+            block_cells(lattice, &corners, key, table, iso, &owners)
         })
         .collect();
-    let positions = owned.iter().flat_map(|o| o.positions.iter().copied()).collect();
-    let normals = owned.iter().flat_map(|o| o.normals.iter().copied()).collect();
+    let positions = owned
+        .iter()
+        .flat_map(|o| o.positions.iter().copied())
+        .collect();
+    let normals = owned
+        .iter()
+        .flat_map(|o| o.normals.iter().copied())
+        .collect();
     Extracted {
         positions,
         normals,

@@ -38,7 +38,11 @@ impl Kernel {
     pub fn new(shape: SurfaceKernel, radius: f64, spacing: f64, dimensions: usize) -> Self {
         let b = radius;
         let a = 9.0 / (b * b);
-        let ramp = if shape == SurfaceKernel::Rectangular { spacing.min(b) } else { 0.0 };
+        let ramp = if shape == SurfaceKernel::Rectangular {
+            spacing.min(b)
+        } else {
+            0.0
+        };
         let d0 = match (shape, dimensions) {
             (SurfaceKernel::Rectangular, _) => 1.0 / ramped_ball(b, ramp, dimensions),
             (SurfaceKernel::Quadric, 2) => 54.0 / (13.0 * PI * b * b),
@@ -105,11 +109,19 @@ fn ramped_ball(b: f64, w: f64, dimensions: usize) -> f64 {
     let (c1, c2) = (b - w / 2.0, b + w / 2.0);
     if dimensions == 2 {
         // π c1² + 2π ∫ (c2 − r)/w r dr over [c1, c2].
-        let shell = if w > 0.0 { (c2 * (c2 * c2 - c1 * c1) / 2.0 - (c2.powi(3) - c1.powi(3)) / 3.0) / w } else { 0.0 };
+        let shell = if w > 0.0 {
+            (c2 * (c2 * c2 - c1 * c1) / 2.0 - (c2.powi(3) - c1.powi(3)) / 3.0) / w
+        } else {
+            0.0
+        };
         PI * c1 * c1 + 2.0 * PI * shell
     } else {
         // 4π c1³/3 + 4π ∫ (c2 − r)/w r² dr over [c1, c2].
-        let shell = if w > 0.0 { (c2 * (c2.powi(3) - c1.powi(3)) / 3.0 - (c2.powi(4) - c1.powi(4)) / 4.0) / w } else { 0.0 };
+        let shell = if w > 0.0 {
+            (c2 * (c2.powi(3) - c1.powi(3)) / 3.0 - (c2.powi(4) - c1.powi(4)) / 4.0) / w
+        } else {
+            0.0
+        };
         4.0 * PI * c1.powi(3) / 3.0 + 4.0 * PI * shell
     }
 }
@@ -187,7 +199,11 @@ impl Profile for Quadric {
     fn at(&self, r2: f32) -> f32 {
         let q2 = r2 * self.inv_b2;
         let t = (1.0 - q2.sqrt()).max(0.0);
-        let w = if q2 <= 1.0 / 9.0 { 1.0 - 3.0 * q2 } else { 1.5 * t * t };
+        let w = if q2 <= 1.0 / 9.0 {
+            1.0 - 3.0 * q2
+        } else {
+            1.5 * t * t
+        };
         self.scale * w
     }
     fn support2(&self) -> f32 {

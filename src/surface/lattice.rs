@@ -70,7 +70,8 @@ pub fn cube_edge<const D: usize>(
         CubeRule::Size(spacings) => spacings * points.spacing,
     };
     let cubes: f64 = cubes_per_axis(extent, edge).iter().product();
-    if !(edge > 0.0) || cubes > MAX_CUBES {
+    let positive = edge > 0.0 && edge.is_finite();
+    if !positive || cubes > MAX_CUBES {
         return Err(SurfaceError::TooManyCubes {
             edge,
             extent: std::array::from_fn(|d| if d < D { extent[d] } else { 0.0 }),
@@ -86,9 +87,8 @@ impl<const D: usize> Lattice<D> {
     pub fn of(points: &Points, edge: f64, radius: f64) -> Self {
         let block = MIN_BLOCK * ((radius / edge) / MIN_BLOCK as f64).ceil().max(1.0) as usize;
         let side = block as f64 * edge;
-        let key_of = |p: &[f64; 3]| -> BlockKey<D> {
-            std::array::from_fn(|d| (p[d] / side).floor() as i64)
-        };
+        let key_of =
+            |p: &[f64; 3]| -> BlockKey<D> { std::array::from_fn(|d| (p[d] / side).floor() as i64) };
         let mut keyed: Vec<(BlockKey<D>, u32)> = points
             .position
             .iter()

@@ -67,7 +67,12 @@ fn reconstruct_in<const D: usize>(
             ..Mesh::default()
         });
     }
-    let kernel = Kernel::new(settings.kernel, settings.radius * points.spacing, points.spacing, D);
+    let kernel = Kernel::new(
+        settings.kernel,
+        settings.radius * points.spacing,
+        points.spacing,
+        D,
+    );
     let edge = lattice::cube_edge::<D>(points, settings.cubes, kernel.support)?;
     let lattice = Lattice::<D>::of(points, edge, kernel.support);
     let values = density::sample(&lattice, points, &kernel);
@@ -82,7 +87,11 @@ fn reconstruct_in<const D: usize>(
     );
     Ok(Mesh {
         dimensions: D,
-        positions: surface.positions.iter().map(|p| p.map(|c| c as f32)).collect(),
+        positions: surface
+            .positions
+            .iter()
+            .map(|p| p.map(|c| c as f32))
+            .collect(),
         normals: surface.normals,
         velocity,
         cells: surface.cells,

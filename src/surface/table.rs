@@ -37,7 +37,10 @@ fn edges(dimensions: usize) -> Vec<(usize, usize)> {
 fn edge_between(edges: &[(usize, usize)], p: usize, q: usize) -> u8 {
     let axis = (p ^ q).trailing_zeros() as usize;
     let start = p.min(q);
-    edges.iter().position(|&e| e == (start, axis)).expect("p and q are neighbours") as u8
+    edges
+        .iter()
+        .position(|&e| e == (start, axis))
+        .expect("p and q are neighbours") as u8
 }
 
 /// The iso-segments of a face whose corners `ring` are listed counter-clockwise as seen from
@@ -81,7 +84,9 @@ impl Table<3> {
     /// Marching cubes.
     pub fn cubes() -> Self {
         let edges = edges(3);
-        let cases = (0..256).map(|inside| cube_triangles(inside, &edges)).collect();
+        let cases = (0..256)
+            .map(|inside| cube_triangles(inside, &edges))
+            .collect();
         Self { cases, edges }
     }
 }
@@ -109,7 +114,9 @@ fn triangulate(lp: &[u8], edges: &[(usize, usize)]) -> Option<Vec<[u8; 3]>> {
             }
             let first: Vec<u8> = lp[i..=j].to_vec();
             let second: Vec<u8> = lp[j..].iter().chain(&lp[..=i]).copied().collect();
-            if let (Some(mut a), Some(b)) = (triangulate(&first, edges), triangulate(&second, edges)) {
+            if let (Some(mut a), Some(b)) =
+                (triangulate(&first, edges), triangulate(&second, edges))
+            {
                 a.extend(b);
                 return Some(a);
             }
@@ -163,7 +170,8 @@ fn cube_triangles(inside: usize, edges: &[(usize, usize)]) -> Vec<[u8; 3]> {
         // from the fluid's side: its triangles are wound the other way, so normals leave the
         // fluid.
         let lp: Vec<u8> = lp.into_iter().rev().collect();
-        triangles.extend(triangulate(&lp, edges).expect("every loop of a cube has a triangulation"));
+        triangles
+            .extend(triangulate(&lp, edges).expect("every loop of a cube has a triangulation"));
     }
     triangles
 }

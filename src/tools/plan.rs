@@ -125,7 +125,11 @@ fn surface_line(s: &SurfaceSettings, dimensions: usize) -> String {
         CubeRule::Size(size) => format!("cubes of {size} dx"),
         CubeRule::MaxCubes(n) => format!("at most {n} cubes over the fluid's box"),
     };
-    let method = if dimensions == 3 { "marching cubes" } else { "marching squares" };
+    let method = if dimensions == 3 {
+        "marching cubes"
+    } else {
+        "marching squares"
+    };
     format!(
         "surface by {method} at c = {} of the {} kernel's density (b = {} dx), {cubes}; surface.h5 + surface.xdmf, a PLY{} per frame in surface/ (a sparse lattice near the fluid, freed after each frame)",
         s.iso,

@@ -38,7 +38,10 @@ pub struct FrameSurface {
 
 #[derive(Debug, thiserror::Error)]
 pub enum SurfaceToolError {
-    #[error("{dir} is not a run's output directory: it holds no {}", frames::FILE_NAME)]
+    #[error(
+        "{dir} is not a run's output directory: it holds no {}",
+        frames::FILE_NAME
+    )]
     NoRun { dir: PathBuf },
     #[error("{path} holds no frames yet")]
     NoFrames { path: PathBuf },
@@ -62,9 +65,9 @@ pub fn select_frames(spec: &str, count: usize) -> Result<Vec<usize>, String> {
     let number = |s: &str| -> Result<usize, String> {
         match s.trim() {
             "last" => Ok(last),
-            t => t
-                .parse::<usize>()
-                .map_err(|_| format!("`{t}` is not a frame number (frames are numbered 0 to {last})")),
+            t => t.parse::<usize>().map_err(|_| {
+                format!("`{t}` is not a frame number (frames are numbered 0 to {last})")
+            }),
         }
     };
     let mut frames = Vec::new();
@@ -80,7 +83,9 @@ pub fn select_frames(spec: &str, count: usize) -> Result<Vec<usize>, String> {
             return Err(format!("the range {first}..{end} runs backwards"));
         }
         if end > last {
-            return Err(format!("frame {end} does not exist: the run holds frames 0 to {last}"));
+            return Err(format!(
+                "frame {end} does not exist: the run holds frames 0 to {last}"
+            ));
         }
         frames.extend(first..=end);
     }
@@ -125,10 +130,12 @@ pub fn surface_run(
         let started = Instant::now();
         let particles = reader.read(frame)?;
         let points = particles.fluid_points(dimensions, spacing);
-        let mesh = surface::reconstruct(&points, &opts.settings).map_err(|source| SurfaceToolError::Surface {
-            frame,
-            path: reader.path().to_owned(),
-            source,
+        let mesh = surface::reconstruct(&points, &opts.settings).map_err(|source| {
+            SurfaceToolError::Surface {
+                frame,
+                path: reader.path().to_owned(),
+                source,
+            }
         })?;
         // The files are replaced only once the first surface has been built: settings that
         // cannot build one leave the old surfaces as they were.
