@@ -355,7 +355,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             };
             let done = surface_run(&run, &opts, |f| {
                 outln!(
-                    "frame {} (t = {} s): {} cells, {} vertices, encloses {:.6e} {} (the particles: {:.6e}), {:.2} s",
+                    "frame {} (t = {} s): {} cells, {} vertices, encloses {:.6e} {} (the particles: {:.6e}), {:.3} s",
                     f.frame,
                     printed(f.time),
                     f.cells,

@@ -210,3 +210,37 @@ pub fn command(program: &str) -> Command {
 pub fn isph_command() -> Command {
     command(env!("CARGO_BIN_EXE_isph"))
 }
+
+/// A 3D block of water `block` m from the origin in a closed tank `tank` m (dx = 0.02 m), run
+/// to `end_time` with frames every `interval` s, with `extra` appended to the scene.
+pub fn water_block_scene_3d(
+    block: [f64; 3],
+    tank: [f64; 3],
+    end_time: f64,
+    interval: f64,
+    extra: &str,
+) -> String {
+    format!(
+        r#"[simulation]
+dimensions = 3
+spacing = 0.02
+end_time = {end_time}
+output_interval = {interval}
+gravity = [0.0, 0.0, -9.81]
+
+[[fluid]]
+name = "water"
+density = 1000.0
+viscosity = 1.0e-6
+
+[[fluid_block]]
+fluid = "water"
+min = [0.0, 0.0, 0.0]
+max = {block:?}
+
+[container]
+min = [0.0, 0.0, 0.0]
+max = {tank:?}
+{extra}"#
+    )
+}

@@ -2,7 +2,7 @@
 //! time, one numbered file per frame with `--all`, a shaded surface in 3D, and bad input
 //! refused with the path named.
 
-use crate::common::{run_scene, scene_from_text, water_block_scene, TempDir};
+use crate::common::{run_scene, scene_from_text, water_block_scene, water_block_scene_3d, TempDir};
 use isph::io::frames::FrameReader;
 use isph::io::surface_files::SurfaceWriter;
 use isph::render::bounds::{self, Bounds};
@@ -21,29 +21,9 @@ fn run_2d(dir: &Path) -> PathBuf {
 
 /// A 3D run of two frames: a 6 × 4 × 6 block (dx = 0.02 m) in a small closed tank.
 fn run_3d(dir: &Path) -> PathBuf {
-    let text = r#"[simulation]
-dimensions = 3
-spacing = 0.02
-end_time = 0.01
-output_interval = 0.01
-gravity = [0.0, 0.0, -9.81]
-
-[[fluid]]
-name = "water"
-density = 1000.0
-viscosity = 1.0e-6
-
-[[fluid_block]]
-fluid = "water"
-min = [0.0, 0.0, 0.0]
-max = [0.12, 0.08, 0.12]
-
-[container]
-min = [0.0, 0.0, 0.0]
-max = [0.24, 0.08, 0.16]
-"#;
+    let text = water_block_scene_3d([0.12, 0.08, 0.12], [0.24, 0.08, 0.16], 0.01, 0.01, "");
     let run = dir.join("run");
-    run_scene(&scene_from_text(text), &run, 0.01);
+    run_scene(&scene_from_text(&text), &run, 0.01);
     run
 }
 

@@ -2,39 +2,15 @@
 //! resume, `isph surface` afterwards, the same bytes on one and two threads, pyvista reading
 //! the XDMF index, and bad input refused with nothing overwritten.
 
-use crate::common::{isph_command, TempDir};
+use crate::common::{isph_command, water_block_scene_3d, TempDir};
 use isph::io::surface_files::SurfaceReader;
 use std::path::{Path, PathBuf};
 
 /// A 3D block of water 8 × 6 × 10 spacings collapsing in a box, frames every 0.02 s to
-/// `end_time`, with `extra` appended (an `[output.surface]` section).
+/// `end_time`, checkpoints every 0.02 s, with `extra` appended (an `[output.surface]` section).
 fn column_3d(end_time: f64, extra: &str) -> String {
-    format!(
-        r#"[simulation]
-dimensions = 3
-spacing = 0.02
-end_time = {end_time}
-output_interval = 0.02
-gravity = [0.0, 0.0, -9.81]
-
-[[fluid]]
-name = "water"
-density = 1000.0
-viscosity = 1.0e-6
-
-[[fluid_block]]
-fluid = "water"
-min = [0.0, 0.0, 0.0]
-max = [0.16, 0.12, 0.2]
-
-[container]
-min = [0.0, 0.0, 0.0]
-max = [0.4, 0.12, 0.3]
-
-[checkpoint]
-interval = 0.02
-{extra}"#
-    )
+    let extra = format!("\n[checkpoint]\ninterval = 0.02\n{extra}");
+    water_block_scene_3d([0.16, 0.12, 0.2], [0.4, 0.12, 0.3], end_time, 0.02, &extra)
 }
 
 fn isph(args: &[&str]) -> std::process::Output {

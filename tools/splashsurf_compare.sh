@@ -48,7 +48,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 
-usage() { sed -n '2,/^set -euo/p' "$0" | sed -e '$d' -e 's/^# \{0,1\}//'; }
+usage() { sed -n '2,/^set -euo/p' "$ROOT/tools/splashsurf_compare.sh" | sed -e '$d' -e 's/^# \{0,1\}//'; }
 die() { echo "splashsurf_compare: error: $*" >&2; exit 1; }
 
 RUN_DIR="" FRAME="last" THREADS=2 RADIUS=3 CUBE=0.5 ISO=0.5 THRESHOLD=0.6 REPEATS=3 WARMUP=1

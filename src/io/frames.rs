@@ -252,17 +252,10 @@ pub struct FrameReader {
 }
 
 impl FrameReader {
-    /// Opens the particles.h5 of `dir` for reading, also while a run is appending to it: the
-    /// run holds HDF5's file lock, so the reader takes none (it sees the frames flushed so far).
+    /// Opens the particles.h5 of `dir` for reading, also while a run is appending to it.
     pub fn open(dir: &Path) -> Result<Self, OutputError> {
         let path = dir.join(FILE_NAME);
-        let file = hdf5::File::with_options()
-            .with_fapl(|p| p.file_locking(false))
-            .open(&path)
-            .map_err(|source| OutputError::Hdf5Read {
-                path: path.clone(),
-                source,
-            })?;
+        let file = super::open_for_reading(&path)?;
         Ok(Self { file, path })
     }
 

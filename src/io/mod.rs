@@ -39,6 +39,18 @@ pub enum OutputError {
     Malformed { path: PathBuf, what: String },
 }
 
+/// Opens an HDF5 file of a run for reading, also while the run is appending to it: the run
+/// holds HDF5's file lock, so a reader takes none (it sees what was flushed so far).
+pub fn open_for_reading(path: &Path) -> Result<hdf5::File, OutputError> {
+    hdf5::File::with_options()
+        .with_fapl(|p| p.file_locking(false))
+        .open(path)
+        .map_err(|source| OutputError::Hdf5Read {
+            path: path.to_owned(),
+            source,
+        })
+}
+
 /// Files that make a directory an isph run.
 pub const RUN_FILES: [&str; 3] = [frames::FILE_NAME, xdmf::FILE_NAME, stats::FILE_NAME];
 

@@ -243,14 +243,8 @@ impl SurfaceReader {
         if !path.exists() {
             return Ok(None);
         }
-        // Without HDF5's file lock, as `FrameReader::open`: a run may be writing it.
-        let file = hdf5::File::with_options()
-            .with_fapl(|p| p.file_locking(false))
-            .open(&path)
-            .map_err(|source| OutputError::Hdf5Read {
-                path: path.clone(),
-                source,
-            })?;
+        // A run may be writing it.
+        let file = super::open_for_reading(&path)?;
         Ok(Some(Self { file, path }))
     }
 
