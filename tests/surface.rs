@@ -353,7 +353,7 @@ fn the_mesh_is_the_same_on_one_and_two_threads() {
 }
 
 #[test]
-fn a_cube_size_that_is_not_positive_or_makes_too_many_cubes_is_refused() {
+fn a_cube_size_that_is_not_positive_or_makes_too_many_cubes_or_points_is_refused() {
     let points = ball(3, 0.05, 0.01, [0.0; 3]);
     for size in [0.0, -1.0, 1e-5] {
         let settings = SurfaceSettings {
@@ -363,4 +363,15 @@ fn a_cube_size_that_is_not_positive_or_makes_too_many_cubes_is_refused() {
         let error = reconstruct(&points, &settings).unwrap_err().to_string();
         assert!(error.contains("cubes"), "{error}");
     }
+    // A kernel 400 cubes wide makes blocks of 400³ points: refused before they are allocated.
+    let settings = SurfaceSettings {
+        radius: 20.0,
+        cubes: CubeRule::Size(0.05),
+        ..SurfaceSettings::default()
+    };
+    let error = reconstruct(&points, &settings).unwrap_err().to_string();
+    assert!(
+        error.contains("lattice points") && error.contains("limit of 1e9"),
+        "{error}"
+    );
 }

@@ -8,6 +8,10 @@ use crate::scene::CubeRule;
 /// Most cubes a reconstruction may span (over the particles' box padded by the kernel radius).
 pub const MAX_CUBES: f64 = 1.0e9;
 
+/// Most lattice points a reconstruction may store (4 GB): blocks are at least a kernel's reach
+/// wide, so a kernel of many cubes makes few but large blocks, more points than its box holds.
+pub const MAX_POINTS: f64 = 1.0e9;
+
 /// Cubes along a block's side: a multiple of this many (the lanes of a row of the density
 /// sums), and at least a kernel radius.
 const MIN_BLOCK: usize = 8;

@@ -52,7 +52,8 @@ impl Mesh {
                     (v[0][0] * v[1][1] - v[1][0] * v[0][1]) / 2.0
                 }
             })
-            .sum()
+            .sum::<f64>()
+            + 0.0 // an empty sum is −0
     }
 
     /// The area of the surface in 3D, the length of the iso-line in 2D.

@@ -45,6 +45,13 @@ pub enum SurfaceError {
         cubes: f64,
         limit: f64,
     },
+    #[error("a kernel of {radius} spacings over cubes of {cube} spacings would store {points:.3e} lattice points, more than the limit of {limit:.0e} (4 bytes each): choose larger cubes or a smaller radius")]
+    TooManyPoints {
+        radius: f64,
+        cube: f64,
+        points: f64,
+        limit: f64,
+    },
 }
 
 /// The surface of `points` (an empty mesh when there are none).
@@ -75,6 +82,15 @@ fn reconstruct_in<const D: usize>(
     );
     let edge = lattice::cube_edge::<D>(points, settings.cubes, kernel.support)?;
     let lattice = Lattice::<D>::of(points, edge, kernel.support);
+    let stored = (lattice.valued.len() * lattice.points_per_block()) as f64;
+    if stored > lattice::MAX_POINTS {
+        return Err(SurfaceError::TooManyPoints {
+            radius: settings.radius,
+            cube: edge / points.spacing,
+            points: stored,
+            limit: lattice::MAX_POINTS,
+        });
+    }
     let values = density::sample(&lattice, points, &kernel);
     let surface = extract::extract(&lattice, &values, table, settings.iso);
     let velocity = attributes::velocities(
