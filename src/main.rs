@@ -8,7 +8,7 @@ use isph::render::{self, ColorField, FrameChoice, RenderOptions};
 use isph::resume::{self, ResumeOptions};
 use isph::scene::SurfaceRequest;
 use isph::study::{plot, StudyOptions};
-use isph::tools::surface::{surface_run, SurfaceOptions};
+use isph::tools::surface::{surface_run, FrameOutcome, SurfaceOptions};
 use isph::Plan;
 use isph::RunReport;
 use isph::Scene;
@@ -353,8 +353,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 out,
                 overwrite,
             };
-            let done = surface_run(&run, &opts, |f| {
-                outln!(
+            let done = surface_run(&run, &opts, |outcome| {
+                match outcome {
+                FrameOutcome::Built(f) => outln!(
                     "frame {} (t = {} s): {} cells, {} vertices, encloses {:.6e} {} (the particles: {:.6e}), {:.3} s",
                     f.frame,
                     printed(f.time),
@@ -364,7 +365,11 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
                     if f.dimensions == 3 { "m³" } else { "m²" },
                     f.fluid,
                     f.seconds
-                );
+                ),
+                FrameOutcome::Skipped { frame, reason } => {
+                    eprintln!("warning: frame {frame} has no surface: {reason}")
+                }
+            }
             })?;
             let dir = opts.out.unwrap_or(run);
             outln!(

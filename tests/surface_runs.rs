@@ -233,6 +233,28 @@ fn bad_surface_requests_are_refused_and_nothing_is_overwritten() {
         }
         assert!(!out.join("surface.h5").exists(), "{args:?} wrote a surface");
     }
+    // --out into a folder whose surface/ holds other files: they stay.
+    let elsewhere = dir.path().join("elsewhere");
+    std::fs::create_dir_all(elsewhere.join("surface")).unwrap();
+    std::fs::write(elsewhere.join("surface/notes.txt"), "mine").unwrap();
+    ok(&["surface", o, "--out", elsewhere.to_str().unwrap()]);
+    ok(&[
+        "surface",
+        o,
+        "--out",
+        elsewhere.to_str().unwrap(),
+        "--overwrite",
+        "--frames",
+        "1",
+    ]);
+    assert_eq!(
+        std::fs::read_to_string(elsewhere.join("surface/notes.txt")).unwrap(),
+        "mine"
+    );
+    assert!(
+        !elsewhere.join("surface/frame_000000.ply").exists()
+            && elsewhere.join("surface/frame_000001.ply").exists()
+    );
     // A surface already there is kept unless --overwrite.
     ok(&["surface", o, "--frames", "0"]);
     let before = std::fs::read(out.join("surface.h5")).unwrap();

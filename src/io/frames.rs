@@ -279,10 +279,17 @@ impl FrameReader {
                 self.file.attr("spacing")?.read_scalar()?,
             ))
         };
-        read().map_err(|_| OutputError::Malformed {
+        let (dimensions, spacing) = read().map_err(|_| OutputError::Malformed {
             path: self.path.clone(),
             what: "it lacks the `dimensions` and `spacing` attributes of the file (written by an isph older than its surface reconstruction): run the scene again".into(),
-        })
+        })?;
+        if !(2..=3).contains(&dimensions) || !(spacing > 0.0 && spacing.is_finite()) {
+            return Err(OutputError::Malformed {
+                path: self.path.clone(),
+                what: format!("its attributes say {dimensions} dimensions at a spacing of {spacing} m: not a run of isph"),
+            });
+        }
+        Ok((dimensions, spacing))
     }
 
     /// The time of every frame, in frame order.

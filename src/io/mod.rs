@@ -74,14 +74,22 @@ pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError
             std::fs::remove_file(dir.join(file)).map_err(dir_error)?;
         }
     }
-    // A surface is the run's own: an overwritten run takes its surfaces with it.
+    // Surfaces belong to the run they were built from: a new run replaces them only when told.
     for file in [surface_files::FILE_NAME, surface_files::INDEX_NAME] {
-        if overwrite && dir.join(file).exists() {
+        if dir.join(file).exists() {
+            if !overwrite {
+                return Err(OutputError::HoldsRun {
+                    dir: dir.to_owned(),
+                    file: file.to_owned(),
+                });
+            }
             std::fs::remove_file(dir.join(file)).map_err(dir_error)?;
         }
     }
-    if overwrite && dir.join(surface_files::MESH_DIR).is_dir() {
-        std::fs::remove_dir_all(dir.join(surface_files::MESH_DIR)).map_err(dir_error)?;
+    if overwrite {
+        for mesh in surface_files::mesh_files(dir) {
+            std::fs::remove_file(mesh).map_err(dir_error)?;
+        }
     }
     let checkpoints = checkpoint_folder::folder(dir);
     if checkpoints.exists() {

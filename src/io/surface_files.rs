@@ -36,6 +36,28 @@ fn frame_of(group: &str) -> Option<usize> {
     group.strip_prefix("frame_")?.parse().ok()
 }
 
+/// The mesh files (`surface/frame_NNNNNN.ply` or `.obj`) in `dir`, in name order.
+pub fn mesh_files(dir: &Path) -> Vec<PathBuf> {
+    mesh_files_from(dir, 0)
+}
+
+/// The mesh files of frames from `first` on.
+fn mesh_files_from(dir: &Path, first: usize) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir.join(MESH_DIR)) else {
+        return Vec::new();
+    };
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let ext = p.extension().and_then(|e| e.to_str());
+            let frame = p.file_stem().and_then(|s| s.to_str()).and_then(frame_of);
+            matches!(ext, Some("ply" | "obj")) && frame.is_some_and(|k| k >= first)
+        })
+        .collect();
+    files.sort();
+    files
+}
+
 /// Writes surfaces into a run's (or any) directory.
 pub struct SurfaceWriter {
     file: hdf5::File,
@@ -61,7 +83,8 @@ impl SurfaceWriter {
     }
 
     /// The surface.h5 of `dir` opened to append to, its surfaces of frames from `first` on
-    /// removed (written after the checkpoint a run resumes from), and the index rewritten.
+    /// removed with their mesh files (written after the checkpoint a run resumes from), and the
+    /// index rewritten.
     pub fn reopen(dir: &Path, first: usize) -> Result<Self, OutputError> {
         let path = dir.join(FILE_NAME);
         let hdf5_error = |source| OutputError::Hdf5 {
@@ -83,6 +106,10 @@ impl SurfaceWriter {
             }
         }
         file.flush().map_err(hdf5_error)?;
+        for mesh in mesh_files_from(dir, first) {
+            std::fs::remove_file(&mesh)
+                .map_err(|source| OutputError::Write { path: mesh, source })?;
+        }
         let writer = Self {
             file,
             dir: dir.to_owned(),

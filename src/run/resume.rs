@@ -161,10 +161,7 @@ pub(crate) fn prepare(
     frames_out.remove_frames_from(frames.len())?;
     xdmf::write(&out, &frames)?;
     let surfaces = match scene.surface {
-        Some(settings) if out.join(surface_files::FILE_NAME).exists() => {
-            Some((SurfaceWriter::reopen(&out, frames.len())?, settings))
-        }
-        Some(settings) => Some((SurfaceWriter::create(&out)?, settings)),
+        Some(settings) => Some((surfaces_from(&out, frames.len())?, settings)),
         None => None,
     };
     Ok(Continuation {
@@ -176,6 +173,19 @@ pub(crate) fn prepare(
             frames,
             surfaces,
         },
+    })
+}
+
+/// The run's surface.h5 cut back to its first `frames` frames; a new one if it has none, or if
+/// it cannot be read (killed in the middle of a write): surfaces are derived from the frames, and
+/// `isph surface` rebuilds the lost ones.
+fn surfaces_from(out: &Path, frames: usize) -> Result<SurfaceWriter, OutputError> {
+    if !out.join(surface_files::FILE_NAME).exists() {
+        return SurfaceWriter::create(out);
+    }
+    SurfaceWriter::reopen(out, frames).or_else(|e| {
+        eprintln!("warning: {e}; the run's surfaces start anew (`isph surface` rebuilds those of earlier frames)");
+        SurfaceWriter::create(out)
     })
 }
 

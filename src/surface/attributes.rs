@@ -85,6 +85,10 @@ struct Bins<const D: usize> {
 impl<const D: usize> Bins<D> {
     fn of(lattice: &Lattice<D>, points: &Points, support: f64, key: &BlockKey<D>) -> Self {
         let side = lattice.block as f64 * lattice.edge;
+        // Cells one support wide, or wider when the block is many supports wide (large cubes,
+        // a small kernel): at most 64 along a side. A vertex reads the cells next to its own,
+        // which hold every particle within one support of it for any cell at least that wide.
+        let cell = support.max((side + 2.0 * support) / 64.0);
         let origin: [f64; 3] = std::array::from_fn(|d| {
             if d < D {
                 key[d] as f64 * side - support
@@ -94,7 +98,7 @@ impl<const D: usize> Bins<D> {
         });
         let size: [usize; 3] = std::array::from_fn(|d| {
             if d < D {
-                ((side + 2.0 * support) / support).ceil() as usize
+                ((side + 2.0 * support) / cell).ceil() as usize
             } else {
                 1
             }
@@ -103,7 +107,7 @@ impl<const D: usize> Bins<D> {
             let mut c = 0;
             for d in (0..3).rev() {
                 let k = if d < D {
-                    ((x[d] - origin[d]) / support).floor()
+                    ((x[d] - origin[d]) / cell).floor()
                 } else {
                     0.0
                 };
@@ -132,7 +136,7 @@ impl<const D: usize> Bins<D> {
         };
         Self {
             origin,
-            cell: support,
+            cell,
             size,
             starts,
             position: std::array::from_fn(|d| {

@@ -94,12 +94,25 @@ pub fn select_frames(spec: &str, count: usize) -> Result<Vec<usize>, String> {
     Ok(frames)
 }
 
+/// What became of one chosen frame.
+#[derive(Debug)]
+pub enum FrameOutcome {
+    Built(FrameSurface),
+    /// No surface could be built (the first chosen frame's failure is an error instead).
+    Skipped {
+        frame: usize,
+        reason: SurfaceError,
+    },
+}
+
 /// Builds and writes the surface of each chosen frame of the run in `run_dir`; `on_frame` hears
-/// of each as it is written.
+/// of each as it is written, or skipped. Settings that cannot build the first chosen frame's
+/// surface are an error, with nothing written; a later frame they cannot build (a drop flung
+/// far, more cubes than allowed) is skipped, as a run skips it.
 pub fn surface_run(
     run_dir: &Path,
     opts: &SurfaceOptions,
-    mut on_frame: impl FnMut(&FrameSurface),
+    mut on_frame: impl FnMut(&FrameOutcome),
 ) -> Result<Vec<FrameSurface>, SurfaceToolError> {
     if !run_dir.join(frames::FILE_NAME).is_file() {
         return Err(SurfaceToolError::NoRun {
@@ -120,9 +133,10 @@ pub fn surface_run(
         what,
     })?;
     let out = opts.out.clone().unwrap_or_else(|| run_dir.to_owned());
-    let target = out.join(surface_files::FILE_NAME);
-    if target.exists() && !opts.overwrite {
-        return Err(SurfaceToolError::Exists { path: target });
+    if !opts.overwrite {
+        if let Some(path) = existing_surfaces(&out) {
+            return Err(SurfaceToolError::Exists { path });
+        }
     }
     let mut writer = None;
     let mut done = Vec::new();
@@ -130,13 +144,20 @@ pub fn surface_run(
         let started = Instant::now();
         let particles = reader.read(frame)?;
         let points = particles.fluid_points(dimensions, spacing);
-        let mesh = surface::reconstruct(&points, &opts.settings).map_err(|source| {
-            SurfaceToolError::Surface {
-                frame,
-                path: reader.path().to_owned(),
-                source,
+        let mesh = match surface::reconstruct(&points, &opts.settings) {
+            Ok(mesh) => mesh,
+            Err(reason) if writer.is_some() => {
+                on_frame(&FrameOutcome::Skipped { frame, reason });
+                continue;
             }
-        })?;
+            Err(source) => {
+                return Err(SurfaceToolError::Surface {
+                    frame,
+                    path: reader.path().to_owned(),
+                    source,
+                })
+            }
+        };
         // The files are replaced only once the first surface has been built: settings that
         // cannot build one leave the old surfaces as they were.
         if writer.is_none() {
@@ -154,22 +175,31 @@ pub fn surface_run(
             fluid: points.position.len() as f64 * spacing.powi(dimensions as i32),
             seconds: started.elapsed().as_secs_f64(),
         };
-        on_frame(&result);
+        on_frame(&FrameOutcome::Built(result.clone()));
         done.push(result);
     }
     Ok(done)
 }
 
-/// A fresh surface.h5 in `out`, the meshes of an earlier surface run removed.
+/// A surface file already in `out`: its surface.h5, or a mesh file in its surface/ folder.
+fn existing_surfaces(out: &Path) -> Option<PathBuf> {
+    let h5 = out.join(surface_files::FILE_NAME);
+    if h5.exists() {
+        return Some(h5);
+    }
+    surface_files::mesh_files(out).into_iter().next()
+}
+
+/// A fresh surface.h5 in `out`, the mesh files of an earlier surface run removed (only those:
+/// the surface/ folder may hold other files).
 fn create_output(out: &Path) -> Result<SurfaceWriter, OutputError> {
-    let err = |source| OutputError::Write {
+    std::fs::create_dir_all(out).map_err(|source| OutputError::Write {
         path: out.to_owned(),
         source,
-    };
-    std::fs::create_dir_all(out).map_err(err)?;
-    let meshes = out.join(surface_files::MESH_DIR);
-    if meshes.is_dir() {
-        std::fs::remove_dir_all(&meshes).map_err(err)?;
+    })?;
+    let writer = SurfaceWriter::create(out)?;
+    for file in surface_files::mesh_files(out) {
+        std::fs::remove_file(&file).map_err(|source| OutputError::Write { path: file, source })?;
     }
-    SurfaceWriter::create(out)
+    Ok(writer)
 }
