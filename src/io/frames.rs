@@ -19,11 +19,12 @@ pub struct FrameInfo {
     pub count: usize,
 }
 
-fn group_name(index: usize) -> String {
+/// The group of frame number `index` (also the name of its surface, `io::surface_files`).
+pub(crate) fn group_name(index: usize) -> String {
     format!("frame_{index:06}")
 }
 
-fn frame_index(group: &str) -> Option<usize> {
+pub(crate) fn frame_index(group: &str) -> Option<usize> {
     group.strip_prefix("frame_")?.parse().ok()
 }
 
@@ -283,7 +284,8 @@ impl FrameReader {
             path: self.path.clone(),
             what: "it lacks the `dimensions` and `spacing` attributes of the file (written by an isph older than its surface reconstruction): run the scene again".into(),
         })?;
-        if !(2..=3).contains(&dimensions) || !(spacing > 0.0 && spacing.is_finite()) {
+        let sensible = (2..=3).contains(&dimensions) && spacing > 0.0 && spacing.is_finite();
+        if !sensible {
             return Err(OutputError::Malformed {
                 path: self.path.clone(),
                 what: format!("its attributes say {dimensions} dimensions at a spacing of {spacing} m: not a run of isph"),

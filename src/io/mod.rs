@@ -51,6 +51,29 @@ pub fn open_for_reading(path: &Path) -> Result<hdf5::File, OutputError> {
         })
 }
 
+/// Writes `bytes` to `path` through a hidden temporary file beside it and a rename, so that a
+/// reader (ParaView, a viewer, ffmpeg) never sees half of the file; the temporary file is
+/// removed if the write fails. Not fsynced: these files can be written again from the frames.
+pub fn replace_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let private = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    match std::fs::write(&private, bytes).and_then(|()| std::fs::rename(&private, path)) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let _ = std::fs::remove_file(&private);
+            Err(e)
+        }
+    }
+}
+
+/// `replace_file`, its error naming the file.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    replace_file(path, bytes).map_err(|source| OutputError::Write {
+        path: path.to_owned(),
+        source,
+    })
+}
+
 /// Files that make a directory an isph run.
 pub const RUN_FILES: [&str; 3] = [frames::FILE_NAME, xdmf::FILE_NAME, stats::FILE_NAME];
 
@@ -63,19 +86,9 @@ pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError
         source,
     };
     std::fs::create_dir_all(dir).map_err(dir_error)?;
-    for file in RUN_FILES {
-        if dir.join(file).exists() {
-            if !overwrite {
-                return Err(OutputError::HoldsRun {
-                    dir: dir.to_owned(),
-                    file: file.to_owned(),
-                });
-            }
-            std::fs::remove_file(dir.join(file)).map_err(dir_error)?;
-        }
-    }
     // Surfaces belong to the run they were built from: a new run replaces them only when told.
-    for file in [surface_files::FILE_NAME, surface_files::INDEX_NAME] {
+    let surfaces = [surface_files::FILE_NAME, surface_files::INDEX_NAME];
+    for file in RUN_FILES.into_iter().chain(surfaces) {
         if dir.join(file).exists() {
             if !overwrite {
                 return Err(OutputError::HoldsRun {

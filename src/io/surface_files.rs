@@ -7,10 +7,10 @@
 //! attribute. The XDMF index lists the frames at the particles' times, so ParaView shows the
 //! surface and the particles of a run together.
 
-use super::OutputError;
+use super::frames::{frame_index, group_name};
+use super::{write_atomically, OutputError};
 use crate::surface::Mesh;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 pub const FILE_NAME: &str = "surface.h5";
@@ -28,14 +28,6 @@ pub struct SurfaceInfo {
     pub cells: usize,
 }
 
-fn group_name(frame: usize) -> String {
-    format!("frame_{frame:06}")
-}
-
-fn frame_of(group: &str) -> Option<usize> {
-    group.strip_prefix("frame_")?.parse().ok()
-}
-
 /// The mesh files (`surface/frame_NNNNNN.ply` or `.obj`) in `dir`, in name order.
 pub fn mesh_files(dir: &Path) -> Vec<PathBuf> {
     mesh_files_from(dir, 0)
@@ -50,7 +42,7 @@ fn mesh_files_from(dir: &Path, first: usize) -> Vec<PathBuf> {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
             let ext = p.extension().and_then(|e| e.to_str());
-            let frame = p.file_stem().and_then(|s| s.to_str()).and_then(frame_of);
+            let frame = p.file_stem().and_then(|s| s.to_str()).and_then(frame_index);
             matches!(ext, Some("ply" | "obj")) && frame.is_some_and(|k| k >= first)
         })
         .collect();
@@ -96,7 +88,7 @@ impl SurfaceWriter {
         let mut names = file.member_names().map_err(hdf5_error)?;
         names.sort();
         for name in names {
-            let Some(frame) = frame_of(&name) else {
+            let Some(frame) = frame_index(&name) else {
                 continue;
             };
             if frame >= first {
@@ -165,14 +157,10 @@ impl SurfaceWriter {
     }
 
     fn write_index(&self) -> Result<(), OutputError> {
-        let path = self.dir.join(INDEX_NAME);
-        let tmp = self.dir.join(format!(".{INDEX_NAME}.tmp"));
-        let err = |source| OutputError::Write {
-            path: path.clone(),
-            source,
-        };
-        std::fs::write(&tmp, index_document(&self.written)).map_err(err)?;
-        std::fs::rename(&tmp, &path).map_err(err)
+        write_atomically(
+            &self.dir.join(INDEX_NAME),
+            index_document(&self.written).as_bytes(),
+        )
     }
 }
 
@@ -345,7 +333,7 @@ pub fn write_ply(path: &Path, mesh: &Mesh, time: f64) -> Result<(), OutputError>
             bytes.extend_from_slice(&(v as i32).to_le_bytes());
         }
     }
-    write_file(path, &bytes)
+    write_atomically(path, &bytes)
 }
 
 /// A Wavefront OBJ file: `v`, `vn` and `f a//a b//b c//c` (3D) or `l a b` (2D), numbered from 1.
@@ -366,18 +354,5 @@ pub fn write_obj(path: &Path, mesh: &Mesh, time: f64) -> Result<(), OutputError>
             let _ = writeln!(text, "l {} {}", cell[0] + 1, cell[1] + 1);
         }
     }
-    write_file(path, text.as_bytes())
-}
-
-/// Writes `bytes` to `path` through a temporary file, so a reader never sees half a mesh.
-fn write_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    let err = |source| OutputError::Write {
-        path: path.to_owned(),
-        source,
-    };
-    let tmp = path.with_extension("tmp");
-    let mut f = std::fs::File::create(&tmp).map_err(err)?;
-    f.write_all(bytes).map_err(err)?;
-    drop(f);
-    std::fs::rename(&tmp, path).map_err(err)
+    write_atomically(path, text.as_bytes())
 }

@@ -58,12 +58,5 @@ pub fn document(frames: &[FrameInfo]) -> String {
 
 /// Rewrites the index atomically (temporary file, then rename), so a reader never sees half of it.
 pub fn write(dir: &Path, frames: &[FrameInfo]) -> Result<(), OutputError> {
-    let path = dir.join(FILE_NAME);
-    let tmp = dir.join(format!(".{FILE_NAME}.tmp"));
-    let err = |source| OutputError::Write {
-        path: path.clone(),
-        source,
-    };
-    std::fs::write(&tmp, document(frames)).map_err(err)?;
-    std::fs::rename(&tmp, &path).map_err(err)
+    super::write_atomically(&dir.join(FILE_NAME), document(frames).as_bytes())
 }

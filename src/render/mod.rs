@@ -294,5 +294,5 @@ fn write_png(image: &raster::Image, target: &Path) -> Result<(), RenderError> {
     };
     let bytes =
         png_file::encode(image).map_err(|e| write_error(std::io::Error::other(e.to_string())))?;
-    png_file::write_atomically(target, &bytes).map_err(write_error)
+    crate::io::replace_file(target, &bytes).map_err(write_error)
 }

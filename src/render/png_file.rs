@@ -1,10 +1,10 @@
 //! PNG files: an RGB image encoded with fixed settings (no time stamp, no text chunk), so the
-//! same pixels give the same bytes; written under a temporary name and renamed, so a viewer or
-//! ffmpeg never reads half a picture. (Not fsynced: after a power cut a picture may be empty,
-//! which rendering again mends; a sync per frame would double the time of `--all`.)
+//! same pixels give the same bytes; written by `io::replace_file` (a temporary name, then a
+//! rename), so a viewer or ffmpeg never reads half a picture. (Not fsynced: after a power cut a
+//! picture may be empty, which rendering again mends; a sync per frame would double the time of
+//! `--all`.)
 
 use super::raster::Image;
-use std::io::{BufWriter, Write};
 use std::path::Path;
 
 /// The eight bytes every PNG file starts with.
@@ -21,24 +21,6 @@ pub fn encode(image: &Image) -> Result<Vec<u8>, png::EncodingError> {
     writer.write_image_data(&image.rgb)?;
     writer.finish()?;
     Ok(bytes)
-}
-
-/// Writes `bytes` to `path` through a temporary file beside it.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let name = path.file_name().unwrap_or_default().to_string_lossy();
-    let private = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let written = (|| {
-        let mut file = BufWriter::new(std::fs::File::create(&private)?);
-        file.write_all(bytes)?;
-        file.flush()
-    })();
-    match written.and_then(|()| std::fs::rename(&private, path)) {
-        Ok(()) => Ok(()),
-        Err(e) => {
-            let _ = std::fs::remove_file(&private);
-            Err(e)
-        }
-    }
 }
 
 /// True when the file at `path` starts as a PNG does.

@@ -19,7 +19,7 @@ use super::raster::{Image, Rect};
 use super::survey::Survey;
 use crate::io::frames::Frame;
 use crate::scene::SurfaceSettings;
-use crate::surface::{self, Mesh, Points, SurfaceError};
+use crate::surface::{self, Mesh, SurfaceError};
 use plotters::prelude::*;
 
 const FLOOR: Rgb = [226, 226, 226];
@@ -39,16 +39,10 @@ pub fn shows_surface(survey: &Survey) -> bool {
 /// The water surface of `frame`, reconstructed from its fluid particles with the default
 /// settings.
 pub fn reconstruct(frame: &Frame, survey: &Survey) -> Result<Mesh, SurfaceError> {
-    let mut points = Points {
-        dimensions: 3,
-        spacing: survey.spacing,
-        ..Points::default()
-    };
-    for i in (0..frame.kind.len()).filter(|&i| frame.kind[i] == FLUID) {
-        points.position.push(frame.position[i]);
-        points.velocity.push(frame.velocity[i]);
-    }
-    surface::reconstruct(&points, &SurfaceSettings::default())
+    surface::reconstruct(
+        &frame.fluid_points(3, survey.spacing),
+        &SurfaceSettings::default(),
+    )
 }
 
 /// The picture of `frame` with its surface `mesh`.

@@ -93,10 +93,14 @@ impl Corners {
         }
     }
 
+    /// Where the point `i` (a block point shifted by `halo`) is stored.
+    fn index(&self, i: [usize; 3]) -> usize {
+        i[0] + self.size[0] * (i[1] + self.size[1] * i[2])
+    }
+
     /// The density at block point `l` (0 to n along each axis).
     fn at(&self, l: [usize; 3]) -> f32 {
-        let i: [usize; 3] = std::array::from_fn(|d| l[d] + self.halo[d]);
-        self.values[i[0] + self.size[0] * (i[1] + self.size[1] * i[2])]
+        self.values[self.index(std::array::from_fn(|d| l[d] + self.halo[d]))]
     }
 
     /// The gradient of the density at block point `l` by central differences, per cube edge.
@@ -109,8 +113,7 @@ impl Corners {
             let (mut below, mut above) = (i, i);
             below[d] -= 1;
             above[d] += 1;
-            let index = |p: [usize; 3]| p[0] + self.size[0] * (p[1] + self.size[1] * p[2]);
-            (self.values[index(above)] - self.values[index(below)]) as f64 / 2.0
+            (self.values[self.index(above)] - self.values[self.index(below)]) as f64 / 2.0
         })
     }
 }
