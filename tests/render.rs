@@ -58,6 +58,20 @@ fn render(run: &Path, opts: &RenderOptions) -> Vec<PathBuf> {
     render_run(run, opts).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// Renders one frame into the .png of `opts` twice: a picture of the asked size, not blank, the
+/// same bytes both times.
+fn assert_picture_of_its_size_twice_the_same(run: &Path, opts: &RenderOptions) {
+    let (png, color) = (&opts.output, opts.color.name());
+    assert_eq!(render(run, opts), vec![png.clone()]);
+    let (w, h, colours) = decode(png);
+    assert_eq!((w, h), opts.size, "{color}");
+    // Viridis discs or shading, grey walls, anti-aliased text: far more than a blank's one colour.
+    assert!(colours > 40, "{color}: {colours} colours");
+    let first = std::fs::read(png).unwrap();
+    render(run, opts);
+    assert_eq!(std::fs::read(png).unwrap(), first, "{color} bytes differ");
+}
+
 #[test]
 fn a_2d_frame_is_a_picture_of_the_asked_size_the_same_every_time() {
     let dir = TempDir::new("render-2d");
@@ -69,19 +83,7 @@ fn a_2d_frame_is_a_picture_of_the_asked_size_the_same_every_time() {
     ] {
         let png = dir.path().join(format!("{}.png", color.name()));
         let opts = options(FrameChoice::One(2), color, size, &png);
-        assert_eq!(render(&run, &opts), vec![png.clone()]);
-        let (w, h, colours) = decode(&png);
-        assert_eq!((w, h), size, "{}", color.name());
-        // Viridis discs, grey walls, anti-aliased text: far more than a blank's one colour.
-        assert!(colours > 40, "{}: {colours} colours", color.name());
-        let first = std::fs::read(&png).unwrap();
-        render(&run, &opts);
-        assert_eq!(
-            std::fs::read(&png).unwrap(),
-            first,
-            "{} bytes differ",
-            color.name()
-        );
+        assert_picture_of_its_size_twice_the_same(&run, &opts);
     }
 }
 
@@ -117,18 +119,7 @@ fn a_3d_frame_is_a_picture_of_the_asked_size_the_same_every_time() {
     for color in [ColorField::Speed, ColorField::Pressure, ColorField::Fluid] {
         let png = dir.path().join(format!("{}.png", color.name()));
         let opts = options(FrameChoice::Last, color, (480, 360), &png);
-        render(&run, &opts);
-        let (w, h, colours) = decode(&png);
-        assert_eq!((w, h), (480, 360));
-        assert!(colours > 40, "{}: {colours} colours", color.name());
-        let first = std::fs::read(&png).unwrap();
-        render(&run, &opts);
-        assert_eq!(
-            std::fs::read(&png).unwrap(),
-            first,
-            "{} bytes differ",
-            color.name()
-        );
+        assert_picture_of_its_size_twice_the_same(&run, &opts);
     }
 }
 
