@@ -2,7 +2,7 @@
 //! resume, `isph surface` afterwards, the same bytes on one and two threads, pyvista reading
 //! the XDMF index, and bad input refused with nothing overwritten.
 
-use crate::common::{isph_command, water_block_scene_3d, TempDir};
+use crate::common::{command, isph_command, water_block_scene_3d, TempDir};
 use isph::io::surface_files::SurfaceReader;
 use std::path::{Path, PathBuf};
 
@@ -107,7 +107,7 @@ fn a_run_with_output_surface_writes_a_closed_mesh_per_frame_that_pyvista_reads()
         ]
     );
     let tool = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/inspect_surface.py");
-    let o = std::process::Command::new("python3")
+    let o = command("python3")
         .args([tool, out.to_str().unwrap()])
         .output()
         .unwrap();
