@@ -8,12 +8,13 @@ use crate::math::kernel::{Quintic, SUPPORT_IN_H};
 use crate::math::memory::ArraySize;
 use crate::neighbours::cell_list::CellList;
 use crate::particles::Particles;
-use crate::scene::Scene;
+use crate::scene::{Probe, ProbeField, Scene};
 use crate::solver::krylov::{SolverError, SolverParams};
 use crate::solver::ppe::PressureOperator;
 use crate::sph;
 use crate::sph::free_surface;
 use crate::sph::interface::Interfaces;
+use crate::sph::probe;
 use crate::step::time_step::{self, Limit};
 use crate::step::timings::Timings;
 use crate::step::{Step, StepError, StepSettings};
@@ -59,6 +60,8 @@ pub struct Simulation<const D: usize> {
     stepper: Step<D>,
     /// Time spent in each stage so far.
     pub timings: Timings,
+    /// The length of the box along each periodic axis (probes read across it).
+    periods: [Option<f64>; D],
 }
 
 impl<const D: usize> Simulation<D> {
@@ -112,12 +115,14 @@ impl<const D: usize> Simulation<D> {
             interfaces,
         );
         let timings = Timings::new(stepper.stages().iter().map(|s| s.name()));
+        let c = &scene.container;
         Ok(Self {
             particles,
             time: 0.0,
             step: 0,
             stepper,
             timings,
+            periods: std::array::from_fn(|d| periodic[d].then(|| c.max[d] - c.min[d])),
         })
     }
 
@@ -216,6 +221,22 @@ impl<const D: usize> Simulation<D> {
                 time,
             },
         }
+    }
+
+    /// The values of `probes` as the particles stand, in the order of their columns in
+    /// `probes.csv` (`Probe::columns`): the Shepard interpolation of the fluid (`sph::probe`).
+    pub fn probe_values(&self, probes: &[Probe]) -> Vec<f64> {
+        let kernel = self.kernel();
+        let mut values = Vec::new();
+        for p in probes {
+            let point = std::array::from_fn(|d| p.point[d]);
+            let sample = probe::sample(&self.particles, &kernel, &self.periods, point);
+            match p.field {
+                ProbeField::Pressure => values.push(sample.pressure),
+                ProbeField::Velocity => values.extend(sample.velocity),
+            }
+        }
+        values
     }
 
     /// Every per-particle array of the step with the stage that holds it, as it is now

@@ -3,7 +3,9 @@
 
 pub mod checkpoint;
 pub mod checkpoint_folder;
+pub mod csv;
 pub mod frames;
+pub mod probes;
 pub mod stats;
 pub mod surface_files;
 pub mod xdmf;
@@ -86,9 +88,14 @@ pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError
         source,
     };
     std::fs::create_dir_all(dir).map_err(dir_error)?;
-    // Surfaces belong to the run they were built from: a new run replaces them only when told.
-    let surfaces = [surface_files::FILE_NAME, surface_files::INDEX_NAME];
-    for file in RUN_FILES.into_iter().chain(surfaces) {
+    // Surfaces and probes belong to the run they were taken from: a new run replaces them only
+    // when told.
+    let others = [
+        surface_files::FILE_NAME,
+        surface_files::INDEX_NAME,
+        probes::FILE_NAME,
+    ];
+    for file in RUN_FILES.into_iter().chain(others) {
         if dir.join(file).exists() {
             if !overwrite {
                 return Err(OutputError::HoldsRun {

@@ -10,6 +10,7 @@ mod stop;
 use crate::io::checkpoint::{Checkpoint, CheckpointError, RunState};
 use crate::io::checkpoint_folder;
 use crate::io::frames::{FrameInfo, FrameWriter};
+use crate::io::probes::ProbesWriter;
 use crate::io::stats::StatsWriter;
 use crate::io::stats::StepStats;
 use crate::io::surface_files::SurfaceWriter;
@@ -134,6 +135,11 @@ fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary
         surfaces: match scene.surface {
             Some(settings) => Some((SurfaceWriter::create(&opts.out)?, settings)),
             None => None,
+        },
+        probes: if scene.probes.is_empty() {
+            None
+        } else {
+            Some(ProbesWriter::create(&opts.out, &scene.probes)?)
         },
     };
     let mut driver = Driver::new(scene, sim, output, None, opts.until, opts.quiet, &opts.stop);
@@ -307,6 +313,9 @@ impl<'a, const D: usize> Driver<'a, D> {
             }
         }
         o.stats.flush()?;
+        if let Some(probes) = &mut o.probes {
+            probes.flush()?;
+        }
         // A frame at the end time before the scheduled one leaves that one due.
         if scheduled {
             self.next_output += 1;
@@ -330,6 +339,9 @@ impl<'a, const D: usize> Driver<'a, D> {
             return Ok(saved.clone());
         }
         self.output.stats.sync()?;
+        if let Some(probes) = &mut self.output.probes {
+            probes.sync()?;
+        }
         self.output.frames_out.sync()?;
         let scene_path =
             std::path::absolute(&self.scene.path).unwrap_or_else(|_| self.scene.path.clone());
@@ -389,6 +401,9 @@ impl<'a, const D: usize> Driver<'a, D> {
                 Ok(s) => s,
                 Err(failure) => {
                     self.output.stats.flush()?;
+                    if let Some(probes) = &mut self.output.probes {
+                        probes.flush()?;
+                    }
                     progress.finish();
                     return Err(RunError::Numerical {
                         failure,
@@ -401,6 +416,9 @@ impl<'a, const D: usize> Driver<'a, D> {
             ppe_total += step.ppe_iterations as u64;
             self.last_dt = step.dt;
             self.output.stats.row(&step, self.wall_seconds())?;
+            if let Some(probes) = &mut self.output.probes {
+                probes.row(self.sim.time, &self.sim.probe_values(&self.scene.probes))?;
+            }
             progress.update(&step);
             self.write_frame_if_due()?;
             if self.checkpoint_due() {

@@ -1,6 +1,7 @@
 //! The files of a run's output directory, open for appending.
 
 use crate::io::frames::{FrameInfo, FrameWriter};
+use crate::io::probes::ProbesWriter;
 use crate::io::stats::StatsWriter;
 use crate::io::surface_files::SurfaceWriter;
 use crate::particles::Particles;
@@ -16,6 +17,8 @@ pub(crate) struct Output {
     pub frames: Vec<FrameInfo>,
     /// `[output.surface]`: surface.h5 and the meshes, with their settings.
     pub surfaces: Option<(SurfaceWriter, SurfaceSettings)>,
+    /// `[[probe]]`: probes.csv (None: the scene has no probe).
+    pub probes: Option<ProbesWriter>,
 }
 
 /// The fluid particles of `p` in id order, as a frame lists them: the surface built during a

@@ -2,9 +2,10 @@
 //! the checkpoint. Every check comes before the first change to a file, so a refused resume
 //! leaves the directory byte for byte as it was.
 
-use crate::io::checkpoint::{Checkpoint, CheckpointError};
+use crate::io::checkpoint::{Checkpoint, CheckpointError, RunState};
 use crate::io::checkpoint_folder::{self, DIR_NAME};
 use crate::io::frames::{self, FrameWriter};
+use crate::io::probes::{self, ProbesWriter};
 use crate::io::stats::{self, StatsWriter};
 use crate::io::surface_files::{self, SurfaceWriter};
 use crate::io::{xdmf, OutputError};
@@ -118,7 +119,8 @@ pub(crate) struct Continuation {
 
 /// Checks that `checkpoint` can be continued (its scene unchanged unless `force`, its run's
 /// frames and rows all there, a stop time after it), then cuts the run back to it: the
-/// checkpoints, frames and stats.csv rows after it are deleted, particles.xdmf is rewritten.
+/// checkpoints, frames and stats.csv and probes.csv rows after it are deleted, particles.xdmf is
+/// rewritten.
 pub(crate) fn prepare(
     checkpoint: &Checkpoint,
     opts: &ResumeOptions,
@@ -147,6 +149,7 @@ pub(crate) fn prepare(
         .into());
     }
     let stats_length = stats::end_of_step(&out, state.step)?;
+    let probes_file = probes_file(&out, &scene, state)?;
 
     // Every check has passed: from here on the run's future after the checkpoint is replaced.
     // particles.h5 is opened for writing first, so that if another program holds it, nothing
@@ -164,6 +167,7 @@ pub(crate) fn prepare(
         Some(settings) => Some((surfaces_from(&out, frames.len())?, settings)),
         None => None,
     };
+    let probes = continue_probes(&out, &scene, state, probes_file)?;
     Ok(Continuation {
         scene,
         output: Output {
@@ -172,8 +176,70 @@ pub(crate) fn prepare(
             stats,
             frames,
             surfaces,
+            probes,
         },
     })
+}
+
+/// What becomes of a run's probes.csv on resume.
+enum ProbesFile {
+    /// It holds the scene's probes: cut back to this length (the checkpoint's row) and continued.
+    Continue(u64),
+    /// There is none, or it holds other probes than the scene's (probes may change between a
+    /// stop and a resume: they do not enter the scene's hash); then it is kept under another
+    /// name (`set_aside`) and a scene with probes starts a new one at the checkpoint.
+    Start { set_aside: bool },
+}
+
+/// Decides `ProbesFile`, before any file changes: a probes.csv with the scene's header must hold
+/// the checkpoint's row, as stats.csv must.
+fn probes_file(out: &Path, scene: &Scene, state: &RunState) -> Result<ProbesFile, OutputError> {
+    let path = out.join(probes::FILE_NAME);
+    if !path.exists() {
+        return Ok(ProbesFile::Start { set_aside: false });
+    }
+    let text = std::fs::read_to_string(&path).map_err(|source| OutputError::Read {
+        path: path.clone(),
+        source,
+    })?;
+    let same_probes = !scene.probes.is_empty()
+        && text.lines().next() == Some(probes::header(&scene.probes).as_str());
+    if !same_probes {
+        return Ok(ProbesFile::Start { set_aside: true });
+    }
+    probes::end_of_time(out, &scene.probes, state.step, state.time).map(ProbesFile::Continue)
+}
+
+/// Carries out `file`: the probes.csv the continued run appends to, if the scene has probes.
+fn continue_probes(
+    out: &Path,
+    scene: &Scene,
+    state: &RunState,
+    file: ProbesFile,
+) -> Result<Option<ProbesWriter>, OutputError> {
+    match file {
+        ProbesFile::Continue(length) => ProbesWriter::append_at(out, length).map(Some),
+        ProbesFile::Start { set_aside } => {
+            if set_aside {
+                let path = out.join(probes::FILE_NAME);
+                let aside = out.join(format!("probes_replaced_at_step_{}.csv", state.step));
+                std::fs::rename(&path, &aside).map_err(|source| OutputError::Write {
+                    path: aside.clone(),
+                    source,
+                })?;
+                eprintln!(
+                    "warning: the scene's probes differ from those of {}: it is kept as {}, and probes.csv starts anew at t = {} s",
+                    path.display(),
+                    aside.display(),
+                    state.time
+                );
+            }
+            if scene.probes.is_empty() {
+                return Ok(None);
+            }
+            ProbesWriter::create(out, &scene.probes).map(Some)
+        }
+    }
 }
 
 /// The run's surface.h5 cut back to its first `frames` frames; a new one if it has none, or if

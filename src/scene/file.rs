@@ -26,6 +26,17 @@ pub(super) struct SceneFile {
     pub(super) walls: WallSettings,
     #[serde(default)]
     pub(super) output: OutputSection,
+    #[serde(default)]
+    pub(super) probe: Vec<ProbeSection>,
+}
+
+/// `[[probe]]` as written (docs/scene-format.md).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ProbeSection {
+    pub(super) name: Option<String>,
+    pub(super) point: Vec<f64>,
+    pub(super) field: String,
 }
 
 /// `[output]`: what a run writes besides the particles.

@@ -3,10 +3,12 @@
 
 mod effects;
 mod file;
+mod probes;
 mod surface;
 mod validate;
 
 pub use effects::{Effects, LesSettings, ShiftingSettings};
+pub use probes::{Probe, ProbeField};
 pub use surface::{CubeRule, SurfaceKernel, SurfaceRequest, SurfaceSettings};
 
 pub use crate::math::aabb::Aabb;
@@ -166,6 +168,8 @@ pub struct Scene {
     pub effects: Effects,
     /// `[output.surface]`: the surface reconstructed at every frame (None: particles only).
     pub surface: Option<SurfaceSettings>,
+    /// `[[probe]]`: points whose field is written to `probes.csv` every step (empty: none).
+    pub probes: Vec<Probe>,
     pub walls: WallSettings,
 }
 
@@ -231,9 +235,11 @@ impl Scene {
     /// A hash of everything in the validated scene that shapes the trajectory: xxh3-64 of its
     /// Debug rendering (which prints every f64 so that it reads back to the same bits), with the
     /// fields that cannot change a step blanked: the file's path, the run's name, `end_time`
-    /// (`--until` overrides it anyway), the checkpoint cadence and the surface output. So comments, formatting and
-    /// defaults written out do not count, and a run can be extended or checkpointed differently
-    /// and still resume without `--force`.
+    /// (`--until` overrides it anyway), the checkpoint cadence, the surface output and the
+    /// probes (what a run records, read off the particles after each step, never fed back into
+    /// them). So comments, formatting and defaults written out do not count, and a run can be
+    /// extended, checkpointed differently or given other probes and still resume without
+    /// `--force`.
     pub fn content_hash(&self) -> u64 {
         let trajectory = Scene {
             path: PathBuf::new(),
@@ -241,6 +247,7 @@ impl Scene {
             end_time: 0.0,
             checkpoint: CheckpointSettings::default(),
             surface: None,
+            probes: Vec::new(),
             ..self.clone()
         };
         xxhash_rust::xxh3::xxh3_64(format!("{trajectory:?}").as_bytes())

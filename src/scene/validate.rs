@@ -2,12 +2,12 @@
 //! key and, where it can be found, the line.
 
 use super::file::{
-    BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection, SceneFile,
-    ShiftingSection, SurfaceSection,
+    BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection,
+    ProbeSection, SceneFile, ShiftingSection, SurfaceSection,
 };
 use super::{
-    Aabb, Block, CheckpointSettings, Effects, InitialVelocity, LesSettings, Scene, SceneError,
-    ShiftingSettings, SolverSettings, SurfaceRequest, SurfaceSettings,
+    Aabb, Block, CheckpointSettings, Effects, InitialVelocity, LesSettings, Probe, ProbeField,
+    Scene, SceneError, ShiftingSettings, SolverSettings, SurfaceRequest, SurfaceSettings,
 };
 use crate::math::kernel::SUPPORT_IN_H;
 use std::path::Path;
@@ -254,6 +254,7 @@ impl Validator<'_> {
             .as_ref()
             .map(|s| self.surface(s))
             .transpose()?;
+        let probes = self.probes(&f.probe, &container)?;
 
         let name = match &s.name {
             Some(n) => {
@@ -295,6 +296,7 @@ impl Validator<'_> {
             effects,
             walls: f.walls,
             surface,
+            probes,
         };
         self.fits_in_memory(&scene)?;
         Ok(scene)
@@ -516,6 +518,74 @@ impl Validator<'_> {
         request
             .settings()
             .map_err(|(key, message)| self.error(&format!("output.surface.{key}"), message))
+    }
+
+    /// `[[probe]]`: each a point inside the container (its faces included: a wall sensor sits on
+    /// the face), a known field, and a name that makes columns of its own in `probes.csv`.
+    fn probes(
+        &self,
+        sections: &[ProbeSection],
+        container: &Aabb,
+    ) -> Result<Vec<Probe>, SceneError> {
+        let dims = container.min.len();
+        let mut probes: Vec<Probe> = Vec::new();
+        for (k, section) in sections.iter().enumerate() {
+            let key = format!("probe[{k}]");
+            let name = section
+                .name
+                .clone()
+                .unwrap_or_else(|| format!("probe_{}", k + 1));
+            let plain = !name.is_empty()
+                && name != "time"
+                && !name.contains(|c: char| {
+                    c == ',' || c == '"' || c.is_whitespace() || c.is_control()
+                });
+            self.check(
+                plain,
+                &format!("{key}.name"),
+                format!("= \"{name}\" must be a plain column name for probes.csv: not empty, not \"time\", no comma, quote or space"),
+            )?;
+            let point_key = format!("{key}.point");
+            self.vector(&section.point, dims, &point_key)?;
+            let inside = (0..dims)
+                .all(|d| (container.min[d]..=container.max[d]).contains(&section.point[d]));
+            self.check(
+                inside,
+                &point_key,
+                format!(
+                    "= {:?} is not inside the container {:?} .. {:?} (a wall sensor sits on the container's face)",
+                    section.point, container.min, container.max
+                ),
+            )?;
+            let field = ProbeField::from_name(&section.field).ok_or_else(|| {
+                self.error(
+                    &format!("{key}.field"),
+                    format!(
+                        "= \"{}\" is not a field a probe records: one of {}",
+                        section.field,
+                        ProbeField::NAMES.map(|n| format!("\"{n}\"")).join(", ")
+                    ),
+                )
+            })?;
+            let probe = Probe {
+                name,
+                point: section.point.clone(),
+                field,
+            };
+            let taken: Vec<String> = probes.iter().flat_map(Probe::columns).collect();
+            let clash = probe.columns().into_iter().find(|c| taken.contains(c));
+            self.check(
+                clash.is_none(),
+                &format!("{key}.name"),
+                format!(
+                    "= \"{}\" gives the column `{}` of probes.csv, which an earlier [[probe]] already has: give each probe its own name",
+                    probe.name,
+                    clash.unwrap_or_default()
+                ),
+            )?;
+            probes.push(probe);
+        }
+        Ok(probes)
     }
 
     fn checkpoint(&self, c: &CheckpointSection) -> Result<CheckpointSettings, SceneError> {

@@ -3,6 +3,7 @@
 
 pub mod free_surface;
 pub mod interface;
+pub mod probe;
 
 use crate::boundary::ghosts::{self, behind_walls, ghost_velocity, Face};
 use crate::math::kernel::Quintic;

@@ -3,7 +3,7 @@
 //! counts come from the arrays themselves (`Simulation::arrays`, `Particles::arrays_mut`), so
 //! the plan and the step cannot disagree.
 
-use crate::scene::{CubeRule, SurfaceSettings};
+use crate::scene::{CubeRule, Probe, SurfaceSettings};
 use crate::scene::{Effects, Scene};
 use crate::simulation::{NoFluid, Simulation};
 use std::fmt;
@@ -32,6 +32,8 @@ pub struct Plan {
     pub effects: Effects,
     /// `[output.surface]`, built at every frame (None: particles only).
     pub surface: Option<SurfaceSettings>,
+    /// `[[probe]]`, read after every step into probes.csv.
+    pub probes: Vec<Probe>,
     /// Per-particle bytes of the particle state (position, velocity, …).
     pub state_bytes_per_particle: usize,
     pub stages: Vec<PlannedStage>,
@@ -76,6 +78,7 @@ impl Plan {
             wall_layers: scene.wall_layers(),
             effects: scene.effects,
             surface: scene.surface,
+            probes: scene.probes.clone(),
             state_bytes_per_particle: state.iter().map(|(_, a)| a.element_bytes()).sum(),
             stages,
         })
@@ -172,6 +175,19 @@ impl fmt::Display for Plan {
         }
         if let Some(s) = &self.surface {
             writeln!(f, "at every frame: {}", surface_line(s, self.dimensions))?;
+        }
+        if !self.probes.is_empty() {
+            writeln!(f, "after every step, into probes.csv (the Shepard sum of the fluid particles within 3h; no array):")?;
+            for p in &self.probes {
+                writeln!(
+                    f,
+                    "      {:<25} {} at {:?} m  columns {}",
+                    p.name,
+                    p.field.name(),
+                    p.point,
+                    p.columns().join(",")
+                )?;
+            }
         }
         write!(
             f,

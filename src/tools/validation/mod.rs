@@ -1,9 +1,10 @@
 //! Error measures of a finished run against a reference solution or experiment, computed from
-//! the run's `particles.h5` and `stats.csv`: what `isph study` plots against wall time and what
+//! the run's `particles.h5`, `stats.csv` and `probes.csv`: what `isph study` plots against wall time and what
 //! the validation tests assert. One file per case.
 
 pub mod dam_break;
 pub mod hydrostatic;
+pub mod lobovsky;
 pub mod poiseuille;
 pub mod taylor_green;
 
@@ -25,14 +26,17 @@ pub enum Case {
     Poiseuille,
     /// The decaying Taylor–Green vortex (`taylor_green.rs`).
     TaylorGreen,
+    /// Wall pressures of a dam break against Lobovsky et al. (2014) (`lobovsky.rs`).
+    LobovskyPressure,
 }
 
 impl Case {
-    pub const ALL: [Case; 4] = [
+    pub const ALL: [Case; 5] = [
         Case::Hydrostatic,
         Case::DamBreakFront,
         Case::Poiseuille,
         Case::TaylorGreen,
+        Case::LobovskyPressure,
     ];
 
     /// The name a study file gives (`measure = "…"`).
@@ -42,6 +46,7 @@ impl Case {
             Case::DamBreakFront => "dam_break_front",
             Case::Poiseuille => "poiseuille",
             Case::TaylorGreen => "taylor_green",
+            Case::LobovskyPressure => "lobovsky_pressure",
         }
     }
 
@@ -52,6 +57,7 @@ impl Case {
             Case::DamBreakFront => &dam_break::DETAILS,
             Case::Poiseuille => &poiseuille::DETAILS,
             Case::TaylorGreen => &taylor_green::DETAILS,
+            Case::LobovskyPressure => &lobovsky::DETAILS,
         }
     }
 }
@@ -126,6 +132,7 @@ pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, Va
         Case::DamBreakFront => dam_break::measure(scene, run_dir),
         Case::Poiseuille => poiseuille::measure(scene, run_dir),
         Case::TaylorGreen => taylor_green::measure(scene, run_dir),
+        Case::LobovskyPressure => lobovsky::measure(scene, run_dir),
     }
 }
 
@@ -158,6 +165,7 @@ pub fn check(case: Case, scene: &Scene) -> Result<(), ValidationError> {
         Case::DamBreakFront => dam_break::Column::new(scene).map(|_| ()),
         Case::Poiseuille => poiseuille::Channel::of(scene).map(|_| ()),
         Case::TaylorGreen => taylor_green::Vortex::of(scene).map(|_| ()),
+        Case::LobovskyPressure => lobovsky::Tank::new(scene).map(|_| ()),
     }
 }
 
