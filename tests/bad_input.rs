@@ -162,6 +162,31 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
                 "mirror",
             ],
         ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[[probe]]\npoint = [0.5, 0.1]\nfield = \"pressure\"",
+            &["probe[0].point", "scene.toml:23", "not inside the container"],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[[probe]]\npoint = [0.1, 0.1]\nfield = \"vorticity\"",
+            &["probe[0].field", "scene.toml:24", "\"vorticity\"", "\"pressure\", \"velocity\""],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[[probe]]\nname = \"A\"\npoint = [0.1, 0.1]\nfield = \"pressure\"\n\n[[probe]]\nname = \"A\"\npoint = [0.2, 0.1]\nfield = \"pressure\"",
+            &["probe[1].name", "scene.toml:28", "column `A`"],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[[probe]]\npoint = [0.1, 0.1, 0.1]\nfield = \"velocity\"",
+            &["probe[0].point", "scene.toml:23", "has 3 components"],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[[probe]]\nname = \"a,b\"\npoint = [0.1, 0.1]\nfield = \"pressure\"",
+            &["probe[0].name", "scene.toml:23", "plain column name"],
+        ),
     ];
     for (from, to, expected) in cases {
         let (code, stderr) = run_text(dir.path(), &good().replace(from, to), &[]);

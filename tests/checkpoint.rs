@@ -36,13 +36,18 @@ fn scene_file(
     file
 }
 
-/// 2D dam break at 2 dx: 40 steps to 16 output intervals.
+/// 2D dam break at 2 dx: 40 steps to 16 output intervals, with a pressure probe on the back
+/// wall's face under the column and a velocity probe in the surge's path.
 fn dam_break_2d(dir: &Path) -> PathBuf {
     let edits = [
         ("spacing = 0.00142875", "spacing = 0.00381"),
         ("output_interval = 0.01", "output_interval = 0.005"),
     ];
-    scene_file(dir, "dam_break_2d.toml", &edits, 0.01, 3)
+    let file = scene_file(dir, "dam_break_2d.toml", &edits, 0.01, 3);
+    let probes = "\n[[probe]]\nname = \"back\"\npoint = [0.0, 0.005]\nfield = \"pressure\"\n\n[[probe]]\npoint = [0.1, 0.005]\nfield = \"velocity\"\n";
+    let text = std::fs::read_to_string(&file).unwrap() + probes;
+    std::fs::write(&file, text).unwrap();
+    file
 }
 
 fn run_options(out: &Path, until: f64) -> RunOptions {
@@ -185,9 +190,22 @@ fn assert_same_final_state<const D: usize>(a: &Path, b: &Path, what: &str) {
     }
 }
 
+/// probes.csv of two runs (when the first has one), byte for byte.
+fn assert_same_probes(a: &Path, b: &Path, what: &str) {
+    let read = |dir: &Path| std::fs::read(dir.join("probes.csv")).ok();
+    let (x, y) = (read(a), read(b));
+    assert_eq!(
+        x.is_some(),
+        y.is_some(),
+        "{what}: probes.csv in one run only"
+    );
+    assert!(x == y, "{what}: probes.csv differs");
+}
+
 fn assert_same_run<const D: usize>(whole: &Path, other: &Path, what: &str) {
     assert_same_frames(whole, other, what);
     assert_same_stats(whole, other, what);
+    assert_same_probes(whole, other, what);
     assert_same_final_state::<D>(whole, other, what);
 }
 
@@ -576,4 +594,30 @@ fn bad_checkpoint_sections_are_refused_with_key_and_line() {
             assert!(e.contains(x), "`{x}` missing from: {e}");
         }
     }
+}
+
+/// Probes are not part of the scene's hash: a run resumed with other probes keeps the old
+/// probes.csv under another name and starts a new one at the checkpoint.
+#[test]
+fn a_run_resumed_with_other_probes_keeps_the_old_readings_aside() {
+    let dir = TempDir::new("ckpt-probes");
+    let file = dam_break_2d(dir.path());
+    let scene = Scene::load(&file).unwrap();
+    let (half, end) = (8.0 * scene.output_interval, 16.0 * scene.output_interval);
+    let out = dir.path().join("run");
+    run::run(&scene, &run_options(&out, half)).unwrap();
+    let before = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&file, text.replace("name = \"back\"", "name = \"rear\"")).unwrap();
+    let step = final_state::<2>(&out).0;
+    let summary = resume_until(&out, end);
+    let aside = out.join(format!("probes_replaced_at_step_{step}.csv"));
+    assert_eq!(std::fs::read_to_string(aside).unwrap(), before);
+    let (columns, rows) = isph::io::probes::read(&out).unwrap();
+    assert_eq!(columns, ["time", "rear", "probe_2_x", "probe_2_y"]);
+    assert_eq!(
+        rows.len() as u64,
+        summary.steps,
+        "rows from the checkpoint on"
+    );
 }

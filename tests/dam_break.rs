@@ -1,7 +1,9 @@
-//! Dam breaks: the 2D surge front against Martin & Moyce (1952) and a 3D run.
+//! Dam breaks: the 2D surge front against Martin & Moyce (1952), the wall pressures' onsets
+//! against Lobovsky et al. (2014), and a 3D run.
 
 use crate::common::{run_scene, shipped_scene, stats_column, TempDir};
 use isph::tools::validation::dam_break::Column;
+use isph::tools::validation::lobovsky::SENSORS;
 use isph::tools::validation::{measure, Case};
 
 /// Martin & Moyce's 2:1 column at a/30 in a tank long enough for all fifteen of their fronts
@@ -52,4 +54,32 @@ fn dam_break_3d_runs_half_a_second() {
     assert!(stats_column(dir.path(), "penetrations")
         .iter()
         .all(|&p| p == 0.0));
+}
+
+/// Lobovsky et al.'s dam break (`scenes/dam_break_lobovsky_2d.toml`) at H/20 (dx = 15 mm), to
+/// t = 0.55 s (t √(g/H) = 3.1, past every sensor's onset): the time the water reaches each
+/// sensor within 3% of the experiment's. A sensor whose centre lies below the first layer of
+/// fluid particles (half a spacing, 7.5 mm: sensor 1, at 3 mm) is not resolved and not asked
+/// for. Measured: see docs/accuracy.md, "Wall pressures against Lobovsky et al. 2014".
+#[test]
+fn wall_pressure_onsets_follow_lobovsky() {
+    let mut scene = shipped_scene("dam_break_lobovsky_2d.toml");
+    scene.spacing = 0.015;
+    let dir = TempDir::new("lobovsky");
+    run_scene(&scene, dir.path(), 0.55);
+    let m = measure(Case::LobovskyPressure, &scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
+    let detail = |name: String| m.details.iter().find(|(n, _)| *n == name).unwrap().1;
+    let resolved: Vec<_> = SENSORS
+        .iter()
+        .filter(|s| s.height >= 0.5 * scene.spacing)
+        .collect();
+    assert_eq!(resolved.len(), 3);
+    for sensor in resolved {
+        let error = detail(format!("onset_error_{}", sensor.name));
+        assert!(
+            error.abs() < 0.03,
+            "{}: onset error {error}: {m:?}",
+            sensor.name
+        );
+    }
 }

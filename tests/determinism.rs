@@ -1,10 +1,10 @@
 //! Same binary + same scene ⇒ the same bits, whatever the thread count.
 
 use crate::common::{read_frame, run_scene, shipped_scene, TempDir};
-use isph::scene::Scene;
+use isph::scene::{Probe, ProbeField, Scene};
 
 /// Runs `scene` to `until` on 1 and on 2 threads and compares the first `frames` frames bit
-/// for bit.
+/// for bit, and probes.csv byte for byte.
 fn assert_thread_count_independent(name: &str, scene: &Scene, until: f64, frames: usize) {
     let dirs = [
         TempDir::new(&format!("det-{name}-1")),
@@ -29,6 +29,26 @@ fn assert_thread_count_independent(name: &str, scene: &Scene, until: f64, frames
             );
         }
     }
+    let probes = |dir: &TempDir| std::fs::read(dir.path().join("probes.csv")).ok();
+    assert_eq!(
+        probes(&dirs[0]),
+        probes(&dirs[1]),
+        "{name}: probes.csv differs between 1 and 2 threads"
+    );
+}
+
+/// A pressure probe on the back wall's face under the column and a velocity probe at its foot,
+/// where the water starts to run.
+fn dam_break_probes() -> Vec<Probe> {
+    let probe = |name: &str, point: Vec<f64>, field| Probe {
+        name: name.into(),
+        point,
+        field,
+    };
+    vec![
+        probe("wall", vec![0.0, 0.02], ProbeField::Pressure),
+        probe("u", vec![0.05, 0.02], ProbeField::Velocity),
+    ]
 }
 
 #[test]
@@ -36,6 +56,7 @@ fn one_and_two_threads_write_bit_identical_frames() {
     let mut scene = shipped_scene("dam_break_2d.toml");
     scene.spacing *= 2.0;
     scene.output_interval = 0.01;
+    scene.probes = dam_break_probes();
     assert_thread_count_independent("dam-break", &scene, 0.03, 3);
 }
 

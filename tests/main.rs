@@ -22,6 +22,7 @@ mod neighbours;
 mod operators;
 mod output_readers;
 mod periodic_flows;
+mod probes;
 mod render;
 mod simd;
 mod stability;
