@@ -155,3 +155,49 @@ fn a_run_is_measured_only_against_its_own_scene() {
     let e = isph::tools::validation::measure(Case::Hydrostatic, &other, dir.path()).unwrap_err();
     assert!(e.to_string().contains("another scene"), "{e}");
 }
+
+#[test]
+fn lobovsky_onset_and_plateau_of_a_known_curve() {
+    use isph::tools::validation::lobovsky::{onset, window_mean};
+    let curve = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.2), (4.0, 0.6), (6.0, 0.6)];
+    assert!((onset(&curve, 0.1).unwrap() - 1.5).abs() < 1e-12);
+    assert_eq!(onset(&curve, 1.0), None);
+    // (0.55 × 0.5 + 0.6 × 1.5) / 2
+    assert!((window_mean(&curve, (3.5, 5.5)).unwrap() - 0.5875).abs() < 1e-12);
+    assert_eq!(window_mean(&curve, (3.5, 6.5)), None);
+}
+
+/// The experiment's onsets and plateaus as docs/accuracy.md gives them.
+#[test]
+fn lobovsky_experiment_onsets_and_plateaus() {
+    use isph::tools::validation::lobovsky::{onset, window_mean, ONSET_LEVEL, PLATEAU, SENSORS};
+    let expected = [
+        (2.408, 0.594),
+        (2.458, 0.662),
+        (2.517, 0.585),
+        (2.763, 0.520),
+    ];
+    for (sensor, (t, p)) in SENSORS.iter().zip(expected) {
+        let curve = sensor.curve();
+        let on = onset(&curve, ONSET_LEVEL).unwrap();
+        let plateau = window_mean(&curve, PLATEAU).unwrap();
+        assert!((on - t).abs() < 5e-4, "{}: onset {on}", sensor.name);
+        assert!(
+            (plateau - p).abs() < 5e-4,
+            "{}: plateau {plateau}",
+            sensor.name
+        );
+    }
+}
+
+#[test]
+fn a_scene_without_the_sensors_is_not_measured_against_lobovsky() {
+    let mut scene = crate::common::shipped_scene("dam_break_lobovsky_2d.toml");
+    isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap();
+    scene.probes[3].point[1] = 0.1;
+    let e = isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap_err();
+    assert!(e.to_string().contains("probe P4 is at [1.61, 0.1]"), "{e}");
+    scene.probes.remove(0);
+    let e = isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap_err();
+    assert!(e.to_string().contains("no pressure probe named P1"), "{e}");
+}
