@@ -28,6 +28,7 @@ const COLUMNS: &[&str] = &[
     "pressure_solve_s",
     "corrector_s",
     "wall_pressure_s",
+    "density_correction_s",
     "shifting_s",
     "advection_s",
     "diagnostics_s",

@@ -2,7 +2,8 @@
 //! decay and the start-up Poiseuille flow, measured by `isph::tools::validation` (the measures of
 //! `isph study`), with the order of convergence fitted from the two spacings.
 
-use crate::common::{run_scene, shipped_scene, TempDir};
+use crate::common::{run_scene, scene_from_text, shipped_scene, TempDir};
+use isph::io::frames::FrameReader;
 use isph::tools::validation::{measure, Case, Measured};
 
 /// Runs the shipped scene `name` at `spacing` to `until` and measures it against `case`.
@@ -23,20 +24,21 @@ fn order(coarse: f64, fine: f64) -> f64 {
     (coarse / fine).log2()
 }
 
-/// Measured (release, t = 1 s): decay rate within 1.3% at dx = L/20 and 0.13% at L/40; velocity
-/// L2 error 5.4% and 1.3%, order 2.0.
+/// Measured (release, t = 1 s, from the perturbed lattice of the shipped scene): decay rate
+/// 8.7% too fast at dx = L/20, 4.3% at L/40 (1.6% at L/80); velocity L2 error 8.5% and 3.7%,
+/// order 1.2 (1.4% at L/80). The error is the dissipation of the projection on particles that
+/// are not on a lattice (docs/accuracy.md, "The start-up error of the Taylor–Green vortex").
 #[test]
 fn taylor_green_decays_at_the_analytic_rate_and_converges() {
     let coarse = measured("taylor_green_2d.toml", Case::TaylorGreen, 0.05, 1.0);
     let fine = measured("taylor_green_2d.toml", Case::TaylorGreen, 0.025, 1.0);
-    for m in [&coarse, &fine] {
-        assert!(m.error < 0.05, "decay rate off by {}", m.error);
-    }
+    assert!(coarse.error < 0.1, "decay rate off by {} at L/20", coarse.error);
+    assert!(fine.error < 0.05, "decay rate off by {} at L/40", fine.error);
     let (l2_coarse, l2_fine) = (
         detail(&coarse, "velocity_l2_error"),
         detail(&fine, "velocity_l2_error"),
     );
-    assert!(l2_fine < 0.03, "velocity L2 error {l2_fine} at L/40");
+    assert!(l2_fine < 0.045, "velocity L2 error {l2_fine} at L/40");
     let p = order(l2_coarse, l2_fine);
     assert!(
         p > 1.0,
@@ -46,6 +48,83 @@ fn taylor_green_decays_at_the_analytic_rate_and_converges() {
 
 /// Measured (release, t = 0.5 s): rms profile error 1.7% of u_max at L/10, 0.47% at L/20,
 /// order 1.9.
+/// A Taylor–Green vortex of another size, speed and viscosity than the shipped one (L = 0.5 m,
+/// U = 0.2 m/s, Re = 50), 40 particles across from a perturbed lattice, to t = L/U: at every
+/// frame the kinetic energy is at most 0.5% above the exact one and the velocity L2 error below
+/// 3% (docs/accuracy.md, "The start-up error of the Taylor–Green vortex"). From a perfect
+/// lattice the lattice breaks up at 0.15–0.2 L/U (L2 error 12–14%, energy 4–6% above the exact
+/// one); from the perturbed lattice with the density-invariance term in the velocity, as Eq. (6)
+/// prints it, the energy climbs 0.1% every 0.1 L/U to 0.64% above. Measured now: L2 at most
+/// 2.3% (at 0.05 L/U, the perturbation settling), the energy always below the exact one.
+#[test]
+fn taylor_green_start_up_adds_no_energy() {
+    let (side, speed, viscosity) = (0.5, 0.2, 0.002);
+    let period = side / speed;
+    let scene = scene_from_text(&format!(
+        r#"[simulation]
+dimensions = 2
+spacing = {spacing}
+end_time = {end}
+output_interval = {interval}
+gravity = [0.0, 0.0]
+perturbation = 0.1
+
+[[fluid]]
+name = "fluid"
+density = 1000.0
+viscosity = {viscosity}
+
+[[fluid_block]]
+fluid = "fluid"
+min = [0.0, 0.0]
+max = [{side}, {side}]
+
+[container]
+min = [0.0, 0.0]
+max = [{side}, {side}]
+periodic = [true, true]
+
+[initial_velocity]
+field = "taylor_green"
+amplitude = {speed}
+
+[effects.les]
+enabled = false
+"#,
+        spacing = side / 40.0,
+        end = period,
+        interval = 0.05 * period,
+    ));
+    let dir = TempDir::new("taylor_green_start_up");
+    run_scene(&scene, dir.path(), scene.end_time);
+    let reader = FrameReader::open(dir.path()).unwrap();
+    let times = reader.times().unwrap();
+    assert_eq!(times.len(), 21);
+    let k = 2.0 * std::f64::consts::PI / side;
+    let rate = 8.0 * std::f64::consts::PI.powi(2) * viscosity / (side * side);
+    for index in 1..times.len() {
+        let frame = reader.read(index).unwrap();
+        let decay = (-rate * frame.time).exp();
+        let (mut energy, mut exact_energy, mut error) = (0.0, 0.0, 0.0);
+        for (x, u) in frame.position.iter().zip(&frame.velocity) {
+            let exact = [
+                speed * decay * (k * x[0]).sin() * (k * x[1]).cos(),
+                -speed * decay * (k * x[0]).cos() * (k * x[1]).sin(),
+            ];
+            energy += u[0] * u[0] + u[1] * u[1];
+            exact_energy += exact[0] * exact[0] + exact[1] * exact[1];
+            error += (u[0] - exact[0]).powi(2) + (u[1] - exact[1]).powi(2);
+        }
+        let (excess, l2) = (energy / exact_energy - 1.0, (error / exact_energy).sqrt());
+        let t = frame.time / period;
+        assert!(
+            excess < 0.005,
+            "kinetic energy {excess:+.4} above the exact one at t = {t:.3} L/U"
+        );
+        assert!(l2 < 0.03, "velocity L2 error {l2:.4} at t = {t:.3} L/U");
+    }
+}
+
 #[test]
 fn poiseuille_follows_the_start_up_series_and_converges() {
     let coarse = measured("poiseuille_2d.toml", Case::Poiseuille, 1.0e-4, 0.5);

@@ -67,6 +67,7 @@ pub(super) struct SimulationSection {
     pub(super) end_time: f64,
     pub(super) output_interval: f64,
     pub(super) gravity: Vec<f64>,
+    pub(super) perturbation: Option<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

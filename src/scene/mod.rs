@@ -151,6 +151,9 @@ pub struct Scene {
     pub name: String,
     pub dimensions: usize,
     pub spacing: f64,
+    /// Largest initial displacement of a fluid particle from its lattice point, per axis, in
+    /// spacings (`fill`).
+    pub perturbation: f64,
     pub end_time: f64,
     pub output_interval: f64,
     pub gravity: Vec<f64>,

@@ -175,64 +175,98 @@ fn surface_pressure(rest_density: f64, gravity: f64, spacing: f64) -> f64 {
     rest_density * gravity * 0.5 * spacing
 }
 
-/// Right-hand side b of the PPE rows (same sign convention as `PressureOperator`); `closed`:
-/// the fluid has no free surface (a particle is pinned as the reference); `sealed`: the
-/// unknowns of each region sealed off from the free surface where the rest has one (its
-/// highest particle pinned), whose compression is balanced like a closed box's;
-/// `density_rate`: α/Δt_max, the rate at which the density-invariance term relaxes the
-/// density error (`divergence_source`).
+/// Right-hand side b of the projection's PPE rows (same sign convention as
+/// `PressureOperator`): −(ρ0/Δt)∇·u* with the walls' known differences in the interior rows,
+/// the surface pressure in the free-surface rows. `closed`: the fluid has no free surface (a
+/// particle is pinned as the reference); `sealed`: the unknowns of each region sealed off from
+/// the free surface where the rest has one (its highest particle pinned), whose compression is
+/// balanced like a closed box's.
 #[allow(clippy::too_many_arguments)]
-pub fn source<const D: usize>(
+pub fn projection_source<const D: usize>(
     op: &PressureOperator<D>,
     closed: bool,
     sealed: &[Vec<usize>],
-    full: &[bool],
     spacing: f64,
     corrections: Corrections<D>,
     u_star: &[Vec<f64>; D],
     dt: f64,
-    density_rate: f64,
     b: &mut Vec<f64>,
 ) {
     let (nb, p) = (op.nb, op.p);
     let g = op.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     b.resize(op.roles.len(), 0.0);
     fill(b, |i| match op.roles[i] {
-        Role::Interior => divergence_source(
-            nb,
-            p,
-            corrections.of(i),
-            u_star,
-            full[i],
-            dt,
-            density_rate,
-            i,
-        ),
+        Role::Interior => divergence_source(nb, p, corrections.of(i), u_star, dt, i),
         Role::Surface => surface_pressure(p.rest_density[i], g, spacing),
         Role::Splash | Role::Reference => 0.0,
     });
-    let net = if closed {
-        net_compression(op.roles, b, b.len(), |k| k)
-    } else {
-        0.0
-    };
-    for region in sealed {
-        let net = net_compression(op.roles, b, region.len(), |k| region[k]);
-        for &i in region {
-            if op.roles[i] == Role::Interior {
-                b[i] -= net;
-            }
-        }
-    }
+    balance_compression(op.roles, closed, sealed, b);
     // The walls' known differences (the Neumann ghosts) complete the interior rows.
     b.par_iter_mut()
         .zip(op.roles)
         .enumerate()
         .for_each(|(i, (b, &role))| {
             if role == Role::Interior {
-                *b = *b - net + op.wall_source(i);
+                *b += op.wall_source(i);
             }
         });
+}
+
+/// Right-hand side b of the density correction's PPE rows: −α (ρ0 − ρ_i)/(Δt Δt_max) in the
+/// interior rows (`density_rate` = α/Δt_max; where the free surface truncates the kernel, only
+/// compression counts: the summation density is low there because neighbours are missing),
+/// zero on the free surface, and no wall term: the correction's walls are mirror ghosts
+/// (∂P/∂n = 0), so their differences vanish. `closed` and `sealed` as in `projection_source`.
+/// A full step (Δt = Δt_max) relaxes the fraction α of the density error, as Eq. (6) printed; a
+/// step cut short to land on a frame relaxes α Δt/Δt_max of it, at the same rate per unit time
+/// (with α/Δt² a short last step, an end time just past a frame, would jolt the particles:
+/// `tests/frame_times.rs`, `a_short_last_step_does_not_kick_the_flow`; docs/stabilisation.md,
+/// "A short step relaxes less").
+pub fn density_source<const D: usize>(
+    op: &PressureOperator<D>,
+    closed: bool,
+    sealed: &[Vec<usize>],
+    full: &[bool],
+    dt: f64,
+    density_rate: f64,
+    b: &mut Vec<f64>,
+) {
+    let p = op.p;
+    b.resize(op.roles.len(), 0.0);
+    fill(b, |i| match op.roles[i] {
+        Role::Interior => {
+            let deviation = p.rest_density[i] - p.density[i];
+            let deviation = if full[i] {
+                deviation
+            } else {
+                deviation.min(0.0)
+            };
+            -density_rate * deviation / dt
+        }
+        Role::Surface | Role::Splash | Role::Reference => 0.0,
+    });
+    balance_compression(op.roles, closed, sealed, b);
+}
+
+/// Takes the net compression out of the interior rows of a closed box and of each sealed
+/// region (`net_compression`).
+fn balance_compression(roles: &[Role], closed: bool, sealed: &[Vec<usize>], b: &mut [f64]) {
+    for region in sealed {
+        let net = net_compression(roles, b, region.len(), |k| region[k]);
+        for &i in region {
+            if roles[i] == Role::Interior {
+                b[i] -= net;
+            }
+        }
+    }
+    if closed {
+        let net = net_compression(roles, b, b.len(), |k| k);
+        b.par_iter_mut().zip(roles).for_each(|(b, &role)| {
+            if role == Role::Interior {
+                *b -= net;
+            }
+        });
+    }
 }
 
 /// In a closed box the interior rows' compression must sum to zero: the volume cannot change,
@@ -267,26 +301,16 @@ fn net_compression(
     }
 }
 
-/// −(ρ0/Δt) ∇·u* − α (ρ0 − ρ_i)/(Δt Δt_max), Eq. (6), with ∇·u* corrected by Eq. (24)–(25) so
+/// −(ρ0/Δt) ∇·u*, the projection's part of Eq. (6), with ∇·u* corrected by Eq. (24)–(25) so
 /// that it is exact for linear velocity fields also where the free surface truncates the kernel.
-/// `density_rate` is α/Δt_max. A full step (Δt = Δt_max) is Eq. (6) as printed; a step cut
-/// short to land on a frame relaxes the density error by the fraction α Δt/Δt_max of it, at
-/// the same rate per unit time. With α/Δt² the velocity the term corrects by grows as 1/Δt,
-/// and a short last step (an end time just past a frame) kicks the flow (`tests/frame_times.rs`,
-/// `a_short_last_step_does_not_kick_the_flow`; docs/stabilisation.md, "A short step relaxes
-/// less").
-#[allow(clippy::too_many_arguments)]
 fn divergence_source<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Correction<D>,
     u_star: &[Vec<f64>; D],
-    full_support: bool,
     dt: f64,
-    density_rate: f64,
     i: usize,
 ) -> f64 {
-    let rho_i = p.density[i];
     // Walls take the fluid's own u*_i less its normal velocity of the last step: the body force
     // is carried by the wall ghosts' Neumann condition, the wall's kinematic condition by the
     // divergence (see `ghosts::ghost_velocity`).
@@ -301,16 +325,7 @@ fn divergence_source<const D: usize>(
     // ∇·u* = trace of the corrected velocity gradient, Eq. (22) with Eq. (24)–(25).
     let grad_u = velocity_gradient(nb, p, l, u_star_i, velocity, i);
     let div: f64 = (0..D).map(|a| grad_u[a][a]).sum();
-    let rho0 = p.rest_density[i];
-    // Where the free surface truncates the kernel the summation density is low because
-    // neighbours are missing, not because the fluid expanded: there only compression counts.
-    let density_deviation = if full_support {
-        rho0 - rho_i
-    } else {
-        (rho0 - rho_i).min(0.0)
-    };
-    let density_term = density_rate * density_deviation / dt;
-    -(rho0 / dt * div + density_term)
+    -p.rest_density[i] / dt * div
 }
 
 /// ρ0_i V_j, the mass of neighbour j's volume at i's rest density: m_j where the fluids share

@@ -52,8 +52,10 @@ impl<const D: usize> Corrector<D> {
         let (roles, full) = (surface.roles, surface.full_support);
         let ghost = set.ghost_gravity();
         fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
-            let p_ref = pressure_reference(nb, p, roles[i], full[i], i);
-            let grad = pressure_gradient(nb, p, ghost, interfaces, corrections.of(i), p_ref, i);
+            let pressure = &p.pressure;
+            let p_ref = pressure_reference(nb, p, pressure, roles[i], full[i], i);
+            let l = corrections.of(i);
+            let grad = pressure_gradient(nb, p, pressure, ghost, interfaces, l, p_ref, i);
             let rho0 = p.rest_density[i];
             let u = std::array::from_fn(|d| u_star[d] - dt * grad[d] / rho0);
             (faces.no_penetration(p.position(i), u, touch), grad)
@@ -84,15 +86,17 @@ impl<const D: usize> Stage<D> for Corrector<D> {
     }
 }
 
-/// ∇P_i of fluid particle i with the corrected gradient (Eq. 20, 24–25), the differences
-/// taken from `p_ref` (`pressure_reference`), and the walls as ghosts of P_i (see `ghosts`)
-/// carrying `ghost_gravity`: a particle whose pressure exceeds p_ref is pushed off a wall it
+/// ∇P_i of the fluid pressures `pressure` at fluid particle i with the corrected gradient
+/// (Eq. 20, 24–25), the differences taken from `p_ref` (`pressure_reference`), and the walls
+/// as ghosts of P_i (see `ghosts`) carrying `ghost_gravity` (zero: mirror ghosts): a particle whose pressure exceeds p_ref is pushed off a wall it
 /// presses on, but not out through a free surface; across the interface of two fluids
 /// (`interfaces`, the distances to it) each difference is weighted by ρ0_i/ρ̄_ij
 /// (`interface::Side::across`).
-fn pressure_gradient<const D: usize>(
+#[allow(clippy::too_many_arguments)]
+pub(super) fn pressure_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    pressure: &[f64],
     ghost_gravity: [f64; D],
     interfaces: Option<interface::Field<D>>,
     l: &Correction<D>,
@@ -101,14 +105,14 @@ fn pressure_gradient<const D: usize>(
 ) -> [f64; D] {
     let (p_ref, side) = (F64s::splat(p_ref), interface::Side::of(p, interfaces, i));
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
-    let own = F64s::splat(p.pressure[i]) - p_ref;
+    let own = F64s::splat(pressure[i]) - p_ref;
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
-        Kind::Fluid => side.across(p, interfaces, lanes, lanes.load(&p.pressure) - p_ref),
+        Kind::Fluid => side.across(p, interfaces, lanes, lanes.load(pressure) - p_ref),
         Kind::Wall => own + ghosts::ghost_pressure_difference(p, ghost_gravity, i, lanes),
     })
 }
 
-/// The pressure at fluid particle i that its pressure gradient takes the differences
+/// The pressure (of `pressure`) at fluid particle i that its pressure gradient takes the differences
 /// P_j − P_i from: P_i itself, but for an unknown of the PPE with the free surface in its
 /// kernel support (`role` Interior, not `full_support`) the value P̃_i of the linear function
 /// fitted to its fluid neighbours' pressures (`sph::fitted_value`; P_i where they fix none).
@@ -120,16 +124,17 @@ fn pressure_gradient<const D: usize>(
 /// under the surface (its largest eigenvalue at rest, by power iteration, exceeds 1), and the
 /// tank sloshes; with P̃_i the largest eigenvalue is 1, the divergence-free fields'
 /// (docs/stabilisation.md, "The pressure reference near the free surface").
-fn pressure_reference<const D: usize>(
+pub(super) fn pressure_reference<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
+    pressure: &[f64],
     role: Role,
     full_support: bool,
     i: usize,
 ) -> f64 {
     if role == Role::Interior && !full_support {
-        sph::fitted_value(nb, p, &p.pressure, i).unwrap_or(p.pressure[i])
+        sph::fitted_value(nb, p, pressure, i).unwrap_or(pressure[i])
     } else {
-        p.pressure[i]
+        pressure[i]
     }
 }

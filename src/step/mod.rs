@@ -23,6 +23,7 @@ mod advection;
 mod cell_list;
 mod corrector;
 mod density;
+mod density_correction;
 mod diagnostics;
 mod eddy_viscosity;
 mod free_surface;
@@ -158,6 +159,7 @@ pub struct Step<const D: usize> {
     predictor: predictor::Predictor<D>,
     pressure_solve: pressure_solve::PressureSolve<D>,
     corrector: corrector::Corrector<D>,
+    density_correction: Option<density_correction::DensityCorrection<D>>,
     wall_pressure: wall_pressure::WallPressure,
     shifting: Option<shifting::Shifting<D>>,
     advection: advection::Advection,
@@ -186,8 +188,10 @@ impl<const D: usize> Step<D> {
                 .then(kernel_correction::KernelCorrection::default),
             eddy_viscosity: effects.les.map(eddy_viscosity::EddyViscosity::new),
             predictor: predictor::Predictor::default(),
-            pressure_solve: pressure_solve::PressureSolve::default(),
+            pressure_solve: pressure_solve::PressureSolve::new(settings.alpha > 0.0),
             corrector: corrector::Corrector::default(),
+            density_correction: (settings.alpha > 0.0)
+                .then(density_correction::DensityCorrection::default),
             wall_pressure: wall_pressure::WallPressure,
             shifting: effects.shifting.map(shifting::Shifting::new),
             advection: advection::Advection,
@@ -220,6 +224,9 @@ impl<const D: usize> Step<D> {
             &self.corrector,
             &self.wall_pressure,
         ]);
+        if let Some(s) = &self.density_correction {
+            stages.push(s);
+        }
         if let Some(s) = &self.shifting {
             stages.push(s);
         }
@@ -340,6 +347,24 @@ impl<const D: usize> Step<D> {
                 self.wall_pressure.run(&nb, &ghosts, &mut p.pressure, nf);
                 laps.lap(wall_pressure::NAME);
             }
+            let density_shift = match &mut self.density_correction {
+                Some(stage) => {
+                    let density_pressure = self.pressure_solve.density_pressure();
+                    let shift = stage.run(
+                        &nb,
+                        p,
+                        set,
+                        &self.faces,
+                        &surface,
+                        interfaces,
+                        density_pressure,
+                        dt,
+                    );
+                    laps.lap(density_correction::NAME);
+                    Some(&*shift)
+                }
+                None => None,
+            };
             let shift = match &mut self.shifting {
                 Some(stage) => {
                     let velocity = self.corrector.velocity_scratch();
@@ -351,6 +376,7 @@ impl<const D: usize> Step<D> {
                         &surface,
                         corrections,
                         velocity,
+                        density_shift,
                         dt,
                     );
                     // Into the particles: u and P at the shifted positions.
@@ -359,7 +385,7 @@ impl<const D: usize> Step<D> {
                     laps.lap(shifting::NAME);
                     Some(shift)
                 }
-                None => None,
+                None => density_shift,
             };
             (solve, density_error, disorder, shift)
         };

@@ -1,6 +1,9 @@
 //! The pressure Poisson equation, Eq. (6), assembled matrix-free (`solver::ppe`) and solved by
-//! BiCGSTAB preconditioned by the aggregation multigrid, from the last pressure (warm start;
-//! the unknowns are the fluid pressures, walls hold none).
+//! BiCGSTAB preconditioned by the aggregation multigrid (the unknowns are the fluid pressures,
+//! walls hold none), as two solves on one operator: the projection's, from the divergence of
+//! u*, warm-started from the last pressure; and with α > 0 the density correction's, from the
+//! density-invariance term, started from zero (`density_correction` turns it into a
+//! displacement).
 
 use super::free_surface::{FreeSurface, Surface};
 use super::time_step::StepLength;
@@ -22,8 +25,11 @@ pub const NAME: &str = "pressure solve";
 pub struct PressureSolve<const D: usize> {
     rows: Rows<D>,
     rhs: Vec<f64>,
-    /// The solution (before the cavitation clip that the particles' pressure takes).
+    /// The projection's solution (before the cavitation clip that the particles' pressure takes).
     pressure: Vec<f64>,
+    /// The density correction's solution P_α, with α > 0 (`density_correction`).
+    density_pressure: Vec<f64>,
+    density_correction: bool,
     bicgstab: BiCgStab,
     multigrid: Multigrid<D>,
 }
@@ -36,8 +42,10 @@ struct Rows<const D: usize> {
     fluid_volume: Vec<f64>,
 }
 
-impl<const D: usize> Default for PressureSolve<D> {
-    fn default() -> Self {
+impl<const D: usize> PressureSolve<D> {
+    /// The solve of a step whose density-invariance term is (`density_correction`) or is not
+    /// (α = 0) solved for.
+    pub fn new(density_correction: bool) -> Self {
         Self {
             rows: Rows {
                 row_vectors: components(),
@@ -45,16 +53,17 @@ impl<const D: usize> Default for PressureSolve<D> {
             },
             rhs: Vec::new(),
             pressure: Vec::new(),
+            density_pressure: Vec::new(),
+            density_correction,
             bicgstab: BiCgStab::default(),
             multigrid: Multigrid::default(),
         }
     }
-}
 
-impl<const D: usize> PressureSolve<D> {
-    /// Solves for Pⁿ⁺¹ from u* (`u_star`) and the density error, with the roles of `surface`
-    /// (sealed regions are pinned there), the divergence corrected by `corrections`; `probe`, if
-    /// any, is handed the operator first.
+    /// Solves for Pⁿ⁺¹ from u* (`u_star`), and with α > 0 for P_α from the density error,
+    /// with the roles of `surface` (sealed regions are pinned there), the divergence corrected
+    /// by `corrections`; `probe`, if any, is handed the operator first. The report sums both
+    /// solves' iterations and keeps the larger residual.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -73,6 +82,8 @@ impl<const D: usize> PressureSolve<D> {
             rows,
             rhs,
             pressure,
+            density_pressure,
+            density_correction,
             bicgstab,
             multigrid,
         } = self;
@@ -90,16 +101,15 @@ impl<const D: usize> PressureSolve<D> {
                     probe(op);
                 }
                 let reference = s.reference;
-                ppe::source(
+                let closed = reference.is_some();
+                ppe::projection_source(
                     op,
-                    reference.is_some(),
+                    closed,
                     sealed,
-                    s.full_support,
                     set.spacing,
                     corrections,
                     u_star,
                     step.dt,
-                    set.alpha / step.limit,
                     rhs,
                 );
                 let roles = op.roles;
@@ -109,18 +119,36 @@ impl<const D: usize> PressureSolve<D> {
                     Role::Interior | Role::Surface => p.pressure[i] - level,
                     Role::Splash | Role::Reference => 0.0,
                 });
-                let info = bicgstab.solve(op, mg, rhs, pressure, set.solver)?;
-                if reference.is_some() {
+                let mut info = bicgstab.solve(op, mg, rhs, pressure, set.solver)?;
+                if closed {
                     zero_mean_pressure(p, pressure);
+                }
+                if *density_correction {
+                    let rate = set.alpha / step.limit;
+                    ppe::density_source(op, closed, sealed, s.full_support, step.dt, rate, rhs);
+                    density_pressure.clear();
+                    density_pressure.resize(nf, 0.0);
+                    let density = bicgstab.solve(op, mg, rhs, density_pressure, set.solver)?;
+                    info = SolveInfo {
+                        iterations: info.iterations + density.iterations,
+                        relative_residual: info.relative_residual.max(density.relative_residual),
+                        converged: info.converged && density.converged,
+                    };
                 }
                 Ok(info)
             },
         )
     }
 
-    /// The solution of the last `run` (before the cavitation clip the particles' pressure takes).
+    /// The projection's solution of the last `run` (before the cavitation clip the particles'
+    /// pressure takes).
     pub fn pressure(&self) -> &[f64] {
         &self.pressure
+    }
+
+    /// The density correction's solution P_α of the last `run` (empty with α = 0).
+    pub fn density_pressure(&self) -> &[f64] {
+        &self.density_pressure
     }
 }
 
@@ -209,10 +237,14 @@ impl<const D: usize> Stage<D> for PressureSolve<D> {
     }
 
     fn describe(&self, set: &StepSettings<D>) -> String {
+        let density = if set.alpha > 0.0 {
+            format!("; a second solve, from zero, of the density correction's P_α, source −α(ρ0 − ρ)/Δt², α = {}, mirror walls, P_α = 0 on the free surface", set.alpha)
+        } else {
+            String::new()
+        };
         format!(
-            "Eq. (6): source −(ρ0/Δt)∇·u*{} − α(ρ0 − ρ)/Δt², α = {}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start",
+            "Eq. (6): the projection's source −(ρ0/Δt)∇·u*{}; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start{density}",
             if set.effects.kernel_correction { " (corrected by L_i)" } else { "" },
-            set.alpha,
             match set.ghost_pressure {
                 GhostPressure::Hydrostatic => "Neumann ghosts of the fluid pressure, P_b = P_i + ρ0 g·N_b r_bi",
                 GhostPressure::Mirror => "mirror ghosts of the fluid pressure, P_b = P_i (∂P/∂n = 0)",
@@ -227,6 +259,12 @@ impl<const D: usize> Stage<D> for PressureSolve<D> {
             ArraySize::of("right-hand side", &self.rhs),
             ArraySize::of("pressure", &self.pressure),
         ];
+        if self.density_correction {
+            arrays.push(ArraySize::of(
+                "density correction pressure",
+                &self.density_pressure,
+            ));
+        }
         arrays.extend(self.bicgstab.arrays());
         arrays.extend(self.multigrid.fine_arrays());
         arrays

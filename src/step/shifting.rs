@@ -31,8 +31,9 @@ impl<const D: usize> Shifting<D> {
         }
     }
 
-    /// δr of the fluid particles, and into `velocity` their velocity at the shifted position
-    /// (Eq. 9) from the velocity gradient (corrected by `corrections`). Returns δr.
+    /// δr of the fluid particles plus `density` (the density correction's displacement, if
+    /// any), and into `velocity` their velocity at the position so displaced (Eq. 9) from the
+    /// velocity gradient (corrected by `corrections`). Returns that whole displacement.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -43,6 +44,7 @@ impl<const D: usize> Shifting<D> {
         surface: &Surface<D>,
         corrections: Corrections<D>,
         velocity: &mut [Vec<f64>; D],
+        density: Option<&[Vec<f64>; D]>,
         dt: f64,
     ) -> &[Vec<f64>; D] {
         let n = surface.roles.len();
@@ -65,6 +67,11 @@ impl<const D: usize> Shifting<D> {
             }
             Role::Splash => [0.0; D],
         });
+        if let Some(density) = density {
+            for (shift, density) in self.shift.iter_mut().zip(density) {
+                shift.iter_mut().zip(density).for_each(|(s, d)| *s += d);
+            }
+        }
         let shift = &self.shift;
         fill_vector(velocity, |i| {
             // Where the free surface is in reach the velocity gradient is no longer that of a

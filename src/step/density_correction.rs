@@ -1,0 +1,96 @@
+//! Density correction: the density-invariance term of Eq. (6) applied to the positions only,
+//! δr = −(Δt²/ρ0)∇P_α, with P_α the solution of the PPE whose source is that term alone
+//! (`pressure_solve`), as Hu & Adams (2007, J. Comput. Phys. 227) correct the density of their
+//! projection. The advection adds δr to Δt uⁿ⁺¹ (and to the shifting's displacement, which then
+//! carries u and P to the new position by Eq. 9).
+//!
+//! Solved together with the divergence, as Eq. (6) prints it, P_α moves the particles by the
+//! same δr in the step, but also leaves −(Δt/ρ0)∇P_α in the velocity, and there it stays. The
+//! summation density of moving, shifted particles is never uniform (0.3% rms on a
+//! Taylor–Green vortex at any resolution), so every step gives the velocity a kick of about
+//! α (δρ/ρ0) dx/Δt, a fixed fraction of the flow speed at a fixed CFL number: a particle-scale
+//! noise that the viscosity damps more slowly than the steps feed it, and an error that stops
+//! converging at about 1% (docs/accuracy.md, "The start-up error of the Taylor–Green vortex").
+//! As a displacement the correction removes the same density error and adds no momentum.
+
+use super::corrector::{pressure_gradient, pressure_reference};
+use super::free_surface::Surface;
+use super::{Stage, StepSettings};
+use crate::boundary::faces::{self, Faces};
+use crate::math::memory::ArraySize;
+use crate::math::reduce::fill_vector;
+use crate::neighbours::Neighbours;
+use crate::particles::{components, Particles};
+use crate::solver::ppe::Role;
+use crate::sph::interface;
+
+pub const NAME: &str = "density correction";
+
+pub struct DensityCorrection<const D: usize> {
+    /// δr of each fluid particle.
+    displacement: [Vec<f64>; D],
+}
+
+impl<const D: usize> Default for DensityCorrection<D> {
+    fn default() -> Self {
+        Self {
+            displacement: components(),
+        }
+    }
+}
+
+impl<const D: usize> DensityCorrection<D> {
+    /// δr of the fluid particles from `density_pressure` (P_α) over a step of `dt`; splashes
+    /// stay in place, and no particle touching a wall face moves into it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        faces: &Faces,
+        surface: &Surface<D>,
+        interfaces: Option<interface::Field<D>>,
+        density_pressure: &[f64],
+        dt: f64,
+    ) -> &mut [Vec<f64>; D] {
+        let n = surface.roles.len();
+        for a in &mut self.displacement {
+            a.resize(n, 0.0);
+        }
+        let (roles, full) = (surface.roles, surface.full_support);
+        let corrections = surface.pressure_corrections;
+        let touch = faces::touching_distance(set.spacing);
+        // The correction's walls are mirror ghosts: no gravity in their differences.
+        let mirror = [0.0; D];
+        fill_vector(&mut self.displacement, |i| {
+            if roles[i] == Role::Splash {
+                return [0.0; D];
+            }
+            let pressure = density_pressure;
+            let p_ref = pressure_reference(nb, p, pressure, roles[i], full[i], i);
+            let l = corrections.of(i);
+            let grad = pressure_gradient(nb, p, pressure, mirror, interfaces, l, p_ref, i);
+            let scale = -dt * dt / p.rest_density[i];
+            faces.no_penetration(p.position(i), grad.map(|g| scale * g), touch)
+        });
+        &mut self.displacement
+    }
+}
+
+impl<const D: usize> Stage<D> for DensityCorrection<D> {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn describe(&self, set: &StepSettings<D>) -> String {
+        format!(
+            "the density-invariance term of Eq. (6) on the positions only: δr = −(Δt²/ρ0)∇P_α, α = {}, the corrector's gradient with mirror walls (Hu & Adams 2007); no momentum",
+            set.alpha
+        )
+    }
+
+    fn arrays(&self) -> Vec<ArraySize> {
+        vec![ArraySize::of_components("δr (density)", &self.displacement)]
+    }
+}
