@@ -3,7 +3,8 @@
 
 use isph::io::frames::Frame;
 use isph::tools::validation::dam_break::{
-    pick_frames, relative_errors, Column, MARTIN_MOYCE_FRONT,
+    experiment_speed, front_speed, interpolate, lead, pick_frames, relative_errors, shifted_rms,
+    speed, Column, MARTIN_MOYCE_FRONT,
 };
 use isph::tools::validation::hydrostatic::WaterColumn;
 use isph::tools::validation::Case;
@@ -113,6 +114,88 @@ fn the_container_bounds_the_points_compared() {
     let reference = c.reference();
     assert_eq!(reference.len(), 7);
     assert!(reference.iter().all(|&(_, z)| z <= 6.3));
+}
+
+/// A front (T, Z) every 0.1 in T from 0 to 10, Z = `z(T)`.
+fn sampled_front(z: impl Fn(f64) -> f64) -> Vec<(f64, f64)> {
+    (0..=100)
+        .map(|k| {
+            let t = 0.1 * k as f64;
+            (t, z(t))
+        })
+        .collect()
+}
+
+#[test]
+fn the_speed_is_the_slope_inside_the_window_only() {
+    // Z = 1 + 1.7 T between T = 1.6 and 3.3, anything else outside.
+    let front = sampled_front(|t| {
+        if (1.55..3.35).contains(&t) {
+            1.0 + 1.7 * t
+        } else {
+            100.0 * t
+        }
+    });
+    assert!((speed(&front) - 1.7).abs() < 1e-12);
+    // The experiment's points inside the window: T = 1.997 and 2.547 only.
+    let chord = (2.995 - 2.292) / (2.547 - 1.997);
+    assert!((experiment_speed() - chord).abs() < 1e-12);
+    assert!((experiment_speed() - 1.278).abs() < 5e-4);
+}
+
+#[test]
+fn the_front_speed_needs_the_compared_points_to_pass_the_window() {
+    let front = sampled_front(|t| 1.0 + 1.5 * t);
+    assert!((front_speed(&front, &MARTIN_MOYCE_FRONT[..5]) - 1.5).abs() < 1e-12);
+    // The fourth point is at T = 2.547: the run, or the tank, stopped inside the window.
+    assert!(front_speed(&front, &MARTIN_MOYCE_FRONT[..4]).is_nan());
+}
+
+#[test]
+fn the_front_is_linear_between_frames_and_held_outside_them() {
+    let front = [(0.0, 1.0), (1.0, 3.0), (2.0, 3.5)];
+    assert_eq!(interpolate(&front, -1.0), 1.0);
+    assert_eq!(interpolate(&front, 0.25), 1.5);
+    assert_eq!(interpolate(&front, 1.0), 3.0);
+    assert_eq!(interpolate(&front, 1.5), 3.25);
+    assert_eq!(interpolate(&front, 7.0), 3.5);
+}
+
+/// The experiment's curve run `tau` earlier: a frame at each of its times less `tau` (so that
+/// the frames hold every corner of the shifted curve), after the standing column at T = 0.
+fn experiment_shifted(tau: f64) -> Vec<(f64, f64)> {
+    let mut front = vec![(0.0, 1.0)];
+    front.extend(MARTIN_MOYCE_FRONT.iter().map(|&(t, z)| (t - tau, z)));
+    front
+}
+
+#[test]
+fn the_lead_of_the_experiment_run_early_or_late_is_that_shift() {
+    for tau in [0.3, 0.137, 0.03, -0.2] {
+        let front = experiment_shifted(tau);
+        let found = lead(&front, &MARTIN_MOYCE_FRONT);
+        assert!((found - tau).abs() < 1e-6, "shift {tau}: lead {found}");
+        assert!(shifted_rms(&front, &MARTIN_MOYCE_FRONT, found) < 1e-5);
+        assert!(shifted_rms(&front, &MARTIN_MOYCE_FRONT, 0.0) > 0.02);
+    }
+    // Shifted by less than 0.045 ahead or 0.38 behind, the window holds the same two points
+    // as the experiment's: the same speed.
+    for tau in [0.03, -0.2] {
+        assert!((speed(&experiment_shifted(tau)) - experiment_speed()).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn the_lead_falls_between_frames_and_scan_points() {
+    // A front at 1.5 a per unit T, 0.137 ahead, sampled every 0.1 (the frames of a run).
+    let front = sampled_front(|t| 1.0 + 1.5 * (t + 0.137));
+    let reference: Vec<(f64, f64)> = MARTIN_MOYCE_FRONT
+        .iter()
+        .map(|&(t, _)| (t, 1.0 + 1.5 * t))
+        .collect();
+    let found = lead(&front, &reference);
+    assert!((found - 0.137).abs() < 1e-6, "lead {found}");
+    assert!((shifted_rms(&front, &reference, 0.0) - 1.5 * 0.137).abs() < 1e-12);
 }
 
 #[test]

@@ -13,6 +13,21 @@
 //! way to the far wall are left out (the wall stops the surge there). Details: the largest of
 //! those errors, how many points were compared, and the height of the water at the back wall
 //! (within a/4 of it) over the initial height, at the last compared time.
+//!
+//! The point error mixes two things: when the experiment's column started to fall (its gate
+//! took a finite time to lift) and how fast the simulated surge runs. Two more details part
+//! them, both from the front of every frame, Z_sim(T) linear between frames:
+//! - the front's speed dZ/dT, the least-squares slope over the frames with T in [1.6, 3.3]
+//!   (past the column's first acceleration, before the surge thins), next to the same fit to
+//!   the experiment's tabulated points in that window (T = 1.997 and 2.547: 1.278); NaN unless
+//!   the compared points reach past the window;
+//! - the lead τ, the time shift in T that best aligns the simulated front with the compared
+//!   points: it minimises Σ_k (Z_sim(T_k − τ) − Z_k)², so τ > 0 when the simulation reaches a
+//!   given Z earlier than the experiment. Z_sim is held at its first frame's value before it
+//!   (the column stands still until released) and at its last frame's after it. The minimum
+//!   is sought over τ in [−1, 1.5] by a scan 0.01 apart refined by golden-section search.
+//!   `front_rms` and `lead_residual_rms` are the rms of Z_sim(T_k − τ) − Z_k (in widths a)
+//!   without and with the shift: how much of the discrepancy a late start explains.
 
 use super::{fluid, no_frames, vertical, Case, Measured, ValidationError};
 use crate::io::frames::{Frame, FrameReader};
@@ -20,7 +35,16 @@ use crate::scene::Scene;
 use crate::solver::ppe::Role;
 use std::path::Path;
 
-pub const DETAILS: [&str; 3] = ["front_error_max", "front_points", "column_height"];
+pub const DETAILS: [&str; 8] = [
+    "front_error_max",
+    "front_points",
+    "column_height",
+    "front_speed",
+    "front_speed_experiment",
+    "lead",
+    "front_rms",
+    "lead_residual_rms",
+];
 
 /// Martin & Moyce (1952), n² = 2, a = 2.25 in: (T = t √(2g/a), Z = x/a), as tabulated in
 /// PySPH's `db_exp_data.py` (`mm_data_2`) from their Figure 3.
@@ -52,6 +76,19 @@ const ASPECT: f64 = 2.0;
 
 /// Tabulated fronts beyond this fraction of the way to the far wall are not compared.
 const REACH: f64 = 0.9;
+
+/// The window of T over which the front's speed is fitted.
+pub const SPEED_WINDOW: (f64, f64) = (1.6, 3.3);
+
+/// The time shifts, in T, among which the lead is sought.
+pub const LEAD_BRACKET: (f64, f64) = (-1.0, 1.5);
+
+/// The spacing of the scan for the lead, in T: finer than the frames (0.1 apart), so the scan's
+/// best shift lies in the basin of the least-squares minimum.
+const LEAD_SCAN_STEP: f64 = 0.01;
+
+/// The width in T to which golden-section search narrows the lead.
+const LEAD_TOLERANCE: f64 = 1e-9;
 
 /// The back-wall strip whose highest fluid particle gives the column height, in widths a.
 const HEIGHT_STRIP: f64 = 0.25;
@@ -189,6 +226,112 @@ pub fn relative_errors(pairs: &[(f64, f64)]) -> Vec<f64> {
         .collect()
 }
 
+/// The least-squares slope of the line through `points` (x, y); NaN for fewer than two
+/// distinct x.
+pub fn slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let mean_x = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let mean_y = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = points
+        .iter()
+        .map(|&(x, y)| (x - mean_x) * (y - mean_y))
+        .sum();
+    let sxx: f64 = points.iter().map(|&(x, _)| (x - mean_x).powi(2)).sum();
+    if points.len() < 2 || sxx == 0.0 {
+        return f64::NAN;
+    }
+    sxy / sxx
+}
+
+/// dZ/dT fitted to the (T, Z) of `front` inside `SPEED_WINDOW`.
+pub fn speed(front: &[(f64, f64)]) -> f64 {
+    let inside: Vec<(f64, f64)> = front
+        .iter()
+        .copied()
+        .filter(|&(t, _)| (SPEED_WINDOW.0..=SPEED_WINDOW.1).contains(&t))
+        .collect();
+    slope(&inside)
+}
+
+/// The simulated front's `speed`, or NaN unless the `compared` points reach past
+/// `SPEED_WINDOW` (the run lasted, and the tank is long enough, for the whole window).
+pub fn front_speed(front: &[(f64, f64)], compared: &[(f64, f64)]) -> f64 {
+    match compared.last() {
+        Some(&(t, _)) if t >= SPEED_WINDOW.1 => speed(front),
+        _ => f64::NAN,
+    }
+}
+
+/// The speed of the experiment's front: the fit to its tabulated points inside `SPEED_WINDOW`.
+pub fn experiment_speed() -> f64 {
+    speed(&MARTIN_MOYCE_FRONT)
+}
+
+/// Z at `t` on `front` ((T, Z), T ascending), linear between its points and held at its first
+/// and last values outside them.
+pub fn interpolate(front: &[(f64, f64)], t: f64) -> f64 {
+    let after = front.partition_point(|&(tf, _)| tf <= t);
+    if after == 0 {
+        return front[0].1;
+    }
+    if after == front.len() {
+        return front[after - 1].1;
+    }
+    let (t0, z0) = front[after - 1];
+    let (t1, z1) = front[after];
+    z0 + (z1 - z0) * (t - t0) / (t1 - t0)
+}
+
+/// The rms of Z_sim(T_k − `lead`) − Z_k over the `reference` points (T_k, Z_k).
+pub fn shifted_rms(front: &[(f64, f64)], reference: &[(f64, f64)], lead: f64) -> f64 {
+    let sum: f64 = reference
+        .iter()
+        .map(|&(t, z)| (interpolate(front, t - lead) - z).powi(2))
+        .sum();
+    (sum / reference.len() as f64).sqrt()
+}
+
+/// The shift τ in `LEAD_BRACKET` that minimises `shifted_rms`: the best of a scan
+/// `LEAD_SCAN_STEP` apart (the first, if several tie), refined by golden-section search within
+/// one step either side. Z_sim is piecewise linear, so the sum of squares may have several
+/// local minima over the bracket; the scan finds the basin of the lowest.
+pub fn lead(front: &[(f64, f64)], reference: &[(f64, f64)]) -> f64 {
+    let rms = |tau: f64| shifted_rms(front, reference, tau);
+    let (low, high) = LEAD_BRACKET;
+    let steps = ((high - low) / LEAD_SCAN_STEP).round() as usize;
+    let best = (0..=steps)
+        .map(|i| low + i as f64 * LEAD_SCAN_STEP)
+        .min_by(|&a, &b| rms(a).total_cmp(&rms(b)))
+        .expect("the scan has points");
+    golden_section(
+        rms,
+        (best - LEAD_SCAN_STEP).max(low),
+        (best + LEAD_SCAN_STEP).min(high),
+    )
+}
+
+/// The minimum of `f` on [a, b], assumed unimodal there, to within `LEAD_TOLERANCE`.
+fn golden_section(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    let mut c = b - ratio * (b - a);
+    let mut d = a + ratio * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    while b - a > LEAD_TOLERANCE {
+        if fc <= fd {
+            b = d;
+            (d, fd) = (c, fc);
+            c = b - ratio * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            (c, fc) = (d, fd);
+            d = a + ratio * (b - a);
+            fd = f(d);
+        }
+    }
+    0.5 * (a + b)
+}
+
 pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
     let case = Case::DamBreakFront;
     let column = Column::new(scene)?;
@@ -223,19 +366,34 @@ pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationErro
             MARTIN_MOYCE_FRONT[0].1
         )));
     }
-    let mut pairs = Vec::new();
-    let mut height = 0.0;
-    for &(k, f) in &picks {
-        let frame = reader.read(f)?;
-        pairs.push((column.front(&frame), reference[k].1));
-        height = column.height_at_wall(&frame);
-    }
+    let front: Vec<(f64, f64)> = times
+        .iter()
+        .enumerate()
+        .map(|(f, &t)| Ok((t, column.front(&reader.read(f)?))))
+        .collect::<Result<_, ValidationError>>()?;
+    let pairs: Vec<(f64, f64)> = picks
+        .iter()
+        .map(|&(k, f)| (front[f].1, reference[k].1))
+        .collect();
+    let last_pick = picks[picks.len() - 1].1;
+    let height = column.height_at_wall(&reader.read(last_pick)?);
     let errors = relative_errors(&pairs);
     let mean = errors.iter().sum::<f64>() / errors.len() as f64;
     let max = errors.iter().copied().fold(0.0, f64::max);
+    let compared: Vec<(f64, f64)> = picks.iter().map(|&(k, _)| reference[k]).collect();
+    let shift = lead(&front, &compared);
     Ok(Measured::new(
         mean,
         &DETAILS,
-        &[max, errors.len() as f64, height],
+        &[
+            max,
+            errors.len() as f64,
+            height,
+            front_speed(&front, &compared),
+            experiment_speed(),
+            shift,
+            shifted_rms(&front, &compared, 0.0),
+            shifted_rms(&front, &compared, shift),
+        ],
     ))
 }
