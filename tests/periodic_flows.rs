@@ -32,8 +32,16 @@ fn order(coarse: f64, fine: f64) -> f64 {
 fn taylor_green_decays_at_the_analytic_rate_and_converges() {
     let coarse = measured("taylor_green_2d.toml", Case::TaylorGreen, 0.05, 1.0);
     let fine = measured("taylor_green_2d.toml", Case::TaylorGreen, 0.025, 1.0);
-    assert!(coarse.error < 0.1, "decay rate off by {} at L/20", coarse.error);
-    assert!(fine.error < 0.05, "decay rate off by {} at L/40", fine.error);
+    assert!(
+        coarse.error < 0.1,
+        "decay rate off by {} at L/20",
+        coarse.error
+    );
+    assert!(
+        fine.error < 0.05,
+        "decay rate off by {} at L/40",
+        fine.error
+    );
     let (l2_coarse, l2_fine) = (
         detail(&coarse, "velocity_l2_error"),
         detail(&fine, "velocity_l2_error"),

@@ -1,4 +1,5 @@
-//! Advection, Eq. (8): rⁿ⁺¹ = rⁿ + Δt uⁿ⁺¹ (+ δr with shifting), then the hard contact with
+//! Advection, Eq. (8): rⁿ⁺¹ = rⁿ + Δt uⁿ⁺¹ + δr, δr the density correction's and the
+//! shifting's displacements (either may be off), then the hard contact with
 //! the wall faces (`Faces::contact`) for the particles the walls' pressure did not stop.
 
 use super::{Stage, StepSettings};
@@ -11,7 +12,8 @@ pub const NAME: &str = "advection";
 pub struct Advection;
 
 impl Advection {
-    /// Moves the `nf` fluid particles over `dt` (plus `shift`, with shifting), then puts those
+    /// Moves the `nf` fluid particles over `dt` (plus `shift`, the displacement of the density
+    /// correction and the shifting, if either runs), then puts those
     /// that crossed a wall face back a quarter spacing inside (at rest the fluid sits half a
     /// spacing off the faces). Returns how many crossed: the penetrations of `stats.csv`.
     pub fn run<const D: usize>(
@@ -66,7 +68,7 @@ impl<const D: usize> Stage<D> for Advection {
     fn describe(&self, set: &StepSettings<D>) -> String {
         format!(
             "Eq. (8): r += Δt u{}; a particle that crossed a wall face is put back a quarter spacing inside (counted in penetrations)",
-            if set.effects.shifting.is_some() { " + δr" } else { "" }
+            if set.effects.shifting.is_some() || set.alpha > 0.0 { " + δr" } else { "" }
         )
     }
 }

@@ -11,7 +11,8 @@
 //! particles" in `advance`: the order of every array (the cell sort), the summation density
 //! (`density`), the pressures and PPE roles (`pressure_solve`), the new velocity (`corrector`),
 //! the walls' pressures on a frame (`wall_pressure`), the shifted velocity and pressure
-//! (`shifting`), the positions (`advection`, then wrapped into a periodic box). `Step` holds the
+//! (`shifting`, over its own displacement plus the `density_correction`'s), the positions
+//! (`advection`, then wrapped into a periodic box). `Step` holds the
 //! scene's constants and the stages' scratch: it is built again from the scene on resume and
 //! never checkpointed.
 //!

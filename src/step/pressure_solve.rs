@@ -13,7 +13,7 @@ use crate::math::reduce::{self, fill};
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Particles};
 use crate::scene::GhostPressure;
-use crate::solver::krylov::{BiCgStab, Preconditioner, SolveInfo, SolverError};
+use crate::solver::krylov::{BiCgStab, Preconditioner, SolveInfo, SolverError, SolverParams};
 use crate::solver::multigrid::Multigrid;
 use crate::solver::ppe::{self, PressureOperator, Role};
 use crate::sph::interface;
@@ -21,6 +21,13 @@ use crate::sph::Corrections;
 use rayon::prelude::*;
 
 pub const NAME: &str = "pressure solve";
+
+/// The relative residual at which the density correction's solve stops (or the scene's
+/// tolerance, if looser). P_α relaxes a tenth (α) of a density error of a few tenths of a per
+/// cent each step: 1% of it is far below what the next step sees, and from a zero start the
+/// solve at the projection's 1e-6 costs as many iterations as the projection itself
+/// (docs/stabilisation.md, "The density correction moves positions, not velocities").
+const DENSITY_TOLERANCE: f64 = 1e-2;
 
 pub struct PressureSolve<const D: usize> {
     rows: Rows<D>,
@@ -128,7 +135,11 @@ impl<const D: usize> PressureSolve<D> {
                     ppe::density_source(op, closed, sealed, s.full_support, step.dt, rate, rhs);
                     density_pressure.clear();
                     density_pressure.resize(nf, 0.0);
-                    let density = bicgstab.solve(op, mg, rhs, density_pressure, set.solver)?;
+                    let params = SolverParams {
+                        tolerance: set.solver.tolerance.max(DENSITY_TOLERANCE),
+                        ..set.solver
+                    };
+                    let density = bicgstab.solve(op, mg, rhs, density_pressure, params)?;
                     info = SolveInfo {
                         iterations: info.iterations + density.iterations,
                         relative_residual: info.relative_residual.max(density.relative_residual),
