@@ -26,8 +26,8 @@ fn order(coarse: f64, fine: f64) -> f64 {
 
 /// Measured (release, t = 1 s, from the perturbed lattice of the shipped scene): decay rate
 /// 8.7% too fast at dx = L/20, 4.3% at L/40 (1.6% at L/80); velocity L2 error 8.5% and 3.7%,
-/// order 1.2 (1.4% at L/80). The error is the dissipation of the projection on particles that
-/// are not on a lattice (docs/accuracy.md, "The start-up error of the Taylor–Green vortex").
+/// order 1.2 (1.4% at L/80). The error is a dissipation of the step, first order in Δt
+/// (docs/accuracy.md, "The start-up error of the Taylor–Green vortex").
 #[test]
 fn taylor_green_decays_at_the_analytic_rate_and_converges() {
     let coarse = measured("taylor_green_2d.toml", Case::TaylorGreen, 0.05, 1.0);
