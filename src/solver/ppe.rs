@@ -1,9 +1,11 @@
 //! The pressure Poisson equation of Eq. (6), assembled matrix-free. The unknowns are the fluid
 //! pressures; wall particles are ghosts of them (see `boundary::ghosts`) and hold no unknown.
 //!
-//! * interior rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i − α (ρ0 − ρ_i)/Δt², with the Laplacian of
-//!   Eq. (27) made first-order consistent where the free surface truncates the kernel. The wall
-//!   pairs of the Laplacian are known ghost differences and move to the right-hand side.
+//! * interior rows:  −∇²P_i = −(ρ0/Δt) ∇·u*_i (`projection_source`), or for the density
+//!   correction's P_α the density-invariance term −α (ρ0 − ρ_i)/Δt² alone (`density_source`);
+//!   Eq. (6) is their sum. The Laplacian of Eq. (27) is made first-order consistent where the
+//!   free surface truncates the kernel. The wall pairs of the Laplacian are known ghost
+//!   differences and move to the right-hand side (the projection's; P_α's walls are mirrors).
 //! * free-surface rows: P_i = ρ0 |g| dx/2 (`surface_pressure`): P = 0 holds on the surface
 //!   itself, half a spacing beyond the centre of the outermost particle, where the volume that
 //!   particle stands for ends. (P_i = 0 at the particle would put the surface half a spacing
