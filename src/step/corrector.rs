@@ -12,7 +12,7 @@ use crate::math::reduce::fill_vector_and_update;
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Kind, Particles};
 use crate::solver::ppe::Role;
-use crate::sph::{self, interface, Correction};
+use crate::sph::{self, interface};
 
 pub const NAME: &str = "corrector";
 
@@ -47,15 +47,10 @@ impl<const D: usize> Corrector<D> {
         for a in &mut self.velocity {
             a.resize(n, 0.0);
         }
-        let corrections = surface.pressure_corrections;
         let touch = faces::touching_distance(set.spacing);
-        let (roles, full) = (surface.roles, surface.full_support);
         let ghost = set.ghost_gravity();
         fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
-            let pressure = &p.pressure;
-            let p_ref = pressure_reference(nb, p, pressure, roles[i], full[i], i);
-            let l = corrections.of(i);
-            let grad = pressure_gradient(nb, p, pressure, ghost, interfaces, l, p_ref, i);
+            let grad = pressure_gradient(nb, p, &p.pressure, surface, ghost, interfaces, i);
             let rho0 = p.rest_density[i];
             let u = std::array::from_fn(|d| u_star[d] - dt * grad[d] / rho0);
             (faces.no_penetration(p.position(i), u, touch), grad)
@@ -86,23 +81,25 @@ impl<const D: usize> Stage<D> for Corrector<D> {
     }
 }
 
-/// ∇P_i of the fluid pressures `pressure` at fluid particle i with the corrected gradient
-/// (Eq. 20, 24–25), the differences taken from `p_ref` (`pressure_reference`), and the walls
+/// ∇P_i of the fluid pressures `pressure` at fluid particle i with the gradient corrected by
+/// `surface`'s pressure corrections (Eq. 20, 24–25), the differences taken from the pressure
+/// reference of its role there (`pressure_reference`), and the walls
 /// as ghosts of P_i (see `ghosts`) carrying `ghost_gravity` (zero: mirror ghosts): a particle whose pressure exceeds p_ref is pushed off a wall it
 /// presses on, but not out through a free surface; across the interface of two fluids
 /// (`interfaces`, the distances to it) each difference is weighted by ρ0_i/ρ̄_ij
 /// (`interface::Side::across`).
-#[allow(clippy::too_many_arguments)]
 pub(super) fn pressure_gradient<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     pressure: &[f64],
+    surface: &Surface<D>,
     ghost_gravity: [f64; D],
     interfaces: Option<interface::Field<D>>,
-    l: &Correction<D>,
-    p_ref: f64,
     i: usize,
 ) -> [f64; D] {
+    let (role, full) = (surface.roles[i], surface.full_support[i]);
+    let p_ref = pressure_reference(nb, p, pressure, role, full, i);
+    let l = surface.pressure_corrections.of(i);
     let (p_ref, side) = (F64s::splat(p_ref), interface::Side::of(p, interfaces, i));
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
     let own = F64s::splat(pressure[i]) - p_ref;
@@ -124,7 +121,7 @@ pub(super) fn pressure_gradient<const D: usize>(
 /// under the surface (its largest eigenvalue at rest, by power iteration, exceeds 1), and the
 /// tank sloshes; with P̃_i the largest eigenvalue is 1, the divergence-free fields'
 /// (docs/stabilisation.md, "The pressure reference near the free surface").
-pub(super) fn pressure_reference<const D: usize>(
+fn pressure_reference<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     pressure: &[f64],

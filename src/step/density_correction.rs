@@ -13,7 +13,7 @@
 //! converging at about 1% (docs/accuracy.md, "The start-up error of the Taylor–Green vortex").
 //! As a displacement the correction removes the same density error and adds no momentum.
 
-use super::corrector::{pressure_gradient, pressure_reference};
+use super::corrector::pressure_gradient;
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
 use crate::boundary::faces::{self, Faces};
@@ -58,19 +58,14 @@ impl<const D: usize> DensityCorrection<D> {
         for a in &mut self.displacement {
             a.resize(n, 0.0);
         }
-        let (roles, full) = (surface.roles, surface.full_support);
-        let corrections = surface.pressure_corrections;
         let touch = faces::touching_distance(set.spacing);
         // The correction's walls are mirror ghosts: no gravity in their differences.
         let mirror = [0.0; D];
         fill_vector(&mut self.displacement, |i| {
-            if roles[i] == Role::Splash {
+            if surface.roles[i] == Role::Splash {
                 return [0.0; D];
             }
-            let pressure = density_pressure;
-            let p_ref = pressure_reference(nb, p, pressure, roles[i], full[i], i);
-            let l = corrections.of(i);
-            let grad = pressure_gradient(nb, p, pressure, mirror, interfaces, l, p_ref, i);
+            let grad = pressure_gradient(nb, p, density_pressure, surface, mirror, interfaces, i);
             let scale = -dt * dt / p.rest_density[i];
             faces.no_penetration(p.position(i), grad.map(|g| scale * g), touch)
         });
