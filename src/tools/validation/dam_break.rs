@@ -29,7 +29,7 @@
 //!   `front_rms` and `lead_residual_rms` are the rms of Z_sim(T_k − τ) − Z_k (in widths a)
 //!   without and with the shift: how much of the discrepancy a late start explains.
 
-use super::{fluid, no_frames, vertical, Case, Measured, ValidationError};
+use super::{fluid, no_frames, surge_vertical, unsuitable, Case, Measured, ValidationError};
 use crate::io::frames::{Frame, FrameReader};
 use crate::scene::Scene;
 use crate::solver::ppe::Role;
@@ -114,21 +114,12 @@ pub struct Column {
 impl Column {
     pub fn new(scene: &Scene) -> Result<Self, ValidationError> {
         let case = Case::DamBreakFront;
-        let (v, g) = vertical(case, scene)?;
+        let (v, g) = surge_vertical(case, scene)?;
         let region = &scene.blocks[0].region;
         let back = scene.container.min[0];
-        let unsuitable = |message: String| ValidationError::Scene {
-            case,
-            path: scene.path.clone(),
-            message,
-        };
-        if v == 0 {
-            return Err(unsuitable(
-                "gravity points along x, the axis the surge runs along".into(),
-            ));
-        }
+        let scene_error = |message: String| unsuitable(case, scene, message);
         if region.min[0] - back > scene.spacing {
-            return Err(unsuitable(format!(
+            return Err(scene_error(format!(
                 "the first fluid block (x from {}) must stand against the container's min-x wall (x = {back})",
                 region.min[0]
             )));
@@ -136,7 +127,7 @@ impl Column {
         let width = region.max[0] - back;
         let height = region.max[v] - region.min[v];
         if (height / width - ASPECT).abs() > 0.02 * ASPECT {
-            return Err(unsuitable(format!(
+            return Err(scene_error(format!(
                 "Martin & Moyce's fronts are for a column twice as high as wide; the first fluid block is {height} m high and {width} m wide (from the back wall)"
             )));
         }

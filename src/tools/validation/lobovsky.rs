@@ -19,7 +19,7 @@
 //! experiment's), `onset_Pk` (T) and `plateau_Pk` (P/(ρ0 g H)) of the run; a plateau whose window
 //! the run did not reach, or an onset it did not, is NaN.
 
-use super::{vertical, Case, Measured, ValidationError};
+use super::{surge_vertical, unsuitable, Case, Measured, ValidationError};
 use crate::io::probes;
 use crate::scene::{ProbeField, Scene};
 use std::path::Path;
@@ -142,17 +142,8 @@ impl Tank {
     /// sensors' heights scaled by H/300 mm (within half of the sensors' 4.2 mm).
     pub fn new(scene: &Scene) -> Result<Self, ValidationError> {
         let case = Case::LobovskyPressure;
-        let (v, g) = vertical(case, scene)?;
-        let unsuitable = |message: String| ValidationError::Scene {
-            case,
-            path: scene.path.clone(),
-            message,
-        };
-        if v == 0 {
-            return Err(unsuitable(
-                "gravity points along x, the axis the surge runs along".into(),
-            ));
-        }
+        let (v, g) = surge_vertical(case, scene)?;
+        let scene_error = |message: String| unsuitable(case, scene, message);
         let column = &scene.blocks[0].region;
         let height = column.max[v] - column.min[v];
         let scale = height / EXPERIMENT_HEIGHT;
@@ -163,7 +154,7 @@ impl Tank {
                 .iter()
                 .find(|p| p.name == sensor.name && p.field == ProbeField::Pressure)
                 .ok_or_else(|| {
-                    unsuitable(format!(
+                    scene_error(format!(
                         "has no pressure probe named {} (the sensors are the [[probe]]s P1-P4)",
                         sensor.name
                     ))
@@ -172,7 +163,7 @@ impl Tank {
             let on_wall = (probe.point[0] - wall).abs() <= 0.5 * scene.spacing;
             let at_height = (probe.point[v] - y).abs() <= 0.0021 * scale;
             if !(on_wall && at_height) {
-                return Err(unsuitable(format!(
+                return Err(scene_error(format!(
                     "probe {} is at {:?}; sensor {} sits on the far wall (x = {wall}) at height {y:.4} m ({} mm scaled by H/300 mm)",
                     sensor.name,
                     probe.point,

@@ -169,6 +169,15 @@ pub fn check(case: Case, scene: &Scene) -> Result<(), ValidationError> {
     }
 }
 
+/// The error of a scene that `case` cannot be measured on, saying why.
+fn unsuitable(case: Case, scene: &Scene, message: impl Into<String>) -> ValidationError {
+    ValidationError::Scene {
+        case,
+        path: scene.path.clone(),
+        message: message.into(),
+    }
+}
+
 /// The axis gravity points down along (it must be along one axis only) and |g|.
 fn vertical(case: Case, scene: &Scene) -> Result<(usize, f64), ValidationError> {
     let along: Vec<usize> = (0..scene.gravity.len())
@@ -176,15 +185,28 @@ fn vertical(case: Case, scene: &Scene) -> Result<(usize, f64), ValidationError> 
         .collect();
     match along[..] {
         [v] if scene.gravity[v] < 0.0 => Ok((v, -scene.gravity[v])),
-        _ => Err(ValidationError::Scene {
+        _ => Err(unsuitable(
             case,
-            path: scene.path.clone(),
-            message: format!(
+            scene,
+            format!(
                 "gravity {:?} must point down one axis (e.g. [0.0, -9.81])",
                 scene.gravity
             ),
-        }),
+        )),
     }
+}
+
+/// `vertical` for a dam break, whose surge runs along x: gravity must not point along it.
+fn surge_vertical(case: Case, scene: &Scene) -> Result<(usize, f64), ValidationError> {
+    let (v, g) = vertical(case, scene)?;
+    if v == 0 {
+        return Err(unsuitable(
+            case,
+            scene,
+            "gravity points along x, the axis the surge runs along",
+        ));
+    }
+    Ok((v, g))
 }
 
 /// The last frame of the run in `run_dir`.

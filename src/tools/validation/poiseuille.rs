@@ -10,7 +10,7 @@
 //! the velocity along the flow. Details: the largest |u − u_exact|/u_max, and the largest
 //! velocity across the channel over u_max.
 
-use super::{fluid, last_frame, Case, Measured, ValidationError};
+use super::{fluid, last_frame, unsuitable, Case, Measured, ValidationError};
 use crate::scene::Scene;
 use std::f64::consts::PI;
 use std::path::Path;
@@ -36,11 +36,11 @@ impl Channel {
     /// gravity (the driving force) along one periodic axis.
     pub fn of(scene: &Scene) -> Result<Channel, ValidationError> {
         let Some((flow, across)) = axes(scene) else {
-            return Err(ValidationError::Scene {
-                case: Case::Poiseuille,
-                path: scene.path.clone(),
-                message: "needs one bounded axis (the plates), every other axis periodic, and gravity (the driving force) along one periodic axis".into(),
-            });
+            return Err(unsuitable(
+                Case::Poiseuille,
+                scene,
+                "needs one bounded axis (the plates), every other axis periodic, and gravity (the driving force) along one periodic axis",
+            ));
         };
         Ok(Channel {
             force: scene.gravity[flow].abs(),

@@ -7,7 +7,7 @@
 //! fitted rate [1/s], and the L2 error of the velocity field of the last frame against the
 //! exact field, relative to the exact field's L2 norm.
 
-use super::{fluid, last_frame, Case, Measured, ValidationError};
+use super::{fluid, last_frame, unsuitable, Case, Measured, ValidationError};
 use crate::io::stats::read_column;
 use crate::scene::{InitialVelocity, Scene};
 use std::f64::consts::PI;
@@ -41,11 +41,7 @@ impl Vortex {
     /// The vortex of `scene`, which needs `[initial_velocity] field = "taylor_green"` and a
     /// viscous fluid.
     pub fn of(scene: &Scene) -> Result<Vortex, ValidationError> {
-        let scene_error = |message: &str| ValidationError::Scene {
-            case: Case::TaylorGreen,
-            path: scene.path.clone(),
-            message: message.into(),
-        };
+        let scene_error = |message: &str| unsuitable(Case::TaylorGreen, scene, message);
         let Some(field @ InitialVelocity::TaylorGreen { .. }) = scene.initial_velocity else {
             return Err(scene_error(
                 "has no `[initial_velocity] field = \"taylor_green\"`",
