@@ -69,9 +69,10 @@ fn dam_break_3d_runs_half_a_second() {
 /// t = 0.55 s (t √(g/H) = 3.1, past every sensor's onset): the time the water reaches each
 /// sensor within 3% of the experiment's. A sensor whose centre lies below the first layer of
 /// fluid particles (half a spacing, 3.75 mm: sensor 1, at 3 mm) is not resolved and not asked
-/// for. Coarser runs read sensor 4 (80 mm) at the edge of the bound (−3.1% at H/20, −2.9% at
-/// H/30); measured at H/40: +0.1%, −1.8%, −0.6% at sensors 2–4 (docs/accuracy.md, "Wall
-/// pressures against Lobovsky et al. 2014").
+/// for. Measured at H/40: −0.6%, −3.0%, +1.4% at sensors 2–4, sensor 3 at the edge of the
+/// bound: at this spacing the first water reaches sensors 1–3 in the same step, so their onsets
+/// differ by the experiment's only (docs/accuracy.md, "Wall pressures against Lobovsky et al.
+/// 2014").
 #[test]
 fn wall_pressure_onsets_follow_lobovsky() {
     let scene = shipped_scene("dam_break_lobovsky_2d.toml");
