@@ -6,15 +6,16 @@
 //!   Phys. 231): the second term pushes apart pairs closer than dx, which breaks up the lines
 //!   that ∇C of evenly spaced lines alone does not see.
 //! * D = A h U Δt with A = 2 (Skillen et al. 2013; DualSPHysics), U the largest fluid speed:
-//!   a displacement of at most A·CFL·h²·|∇C| per step, independent of Δt per unit of flow
+//!   a displacement of at most A·C·h dx·|∇C| per step (C the CFL number on the spacing),
+//!   independent of Δt per unit of flow
 //!   travel. The particle's own speed would leave disorder untouched near stagnation points,
 //!   where the flow still stretches the fluid.
 //! * D is capped at `MAX_DIFFUSION_NUMBER` h²: the shift is one explicit step of a diffusion
 //!   of the particle concentration (δC ≈ D ∇²C), stable only below a diffusion number of about
-//!   one, and with U Δt ≤ C h the number A h U Δt / h² reaches A·C, 0.4 at the defaults but 2
-//!   at CFL 1.0. On the a/30 impact the cap lowers the mean density error at CFL 1.0 and
-//!   changes little at CFL 0.5 (docs/stabilisation.md, "Particle shifting"); at the default
-//!   CFL 0.2 it never acts.
+//!   one, and with U Δt ≤ C dx the number A h U Δt / h² reaches A·C dx/h, 0.67 at the
+//!   defaults (C = 0.4, h/dx = 1.2) but 1.67 at CFL 1.0. On the a/30 impact the cap lowers the
+//!   mean density error at the largest steps and changes little at CFL 0.6 (docs/stabilisation.md,
+//!   "Particle shifting"); at the default CFL 0.4 it never acts.
 //! * Where the free surface truncates the kernel support, ∇C points out of the fluid; there
 //!   only the part tangential to the surface is kept (normal of `free_surface`).
 //! * Each component is capped at 0.1 dx.

@@ -78,7 +78,7 @@ pub struct SolverSettings {
     pub max_iterations: usize,
     /// Relaxation α of the density-invariance term of the PPE source, Eq. (6).
     pub alpha: f64,
-    /// Courant number C of Δt ≤ C h / |u|max.
+    /// Courant number C of Δt ≤ C dx / |u|max, on the particle spacing as the peers define it.
     pub cfl: f64,
     /// Smoothing length over particle spacing, h/dx.
     pub h_over_dx: f64,
@@ -90,7 +90,7 @@ impl Default for SolverSettings {
             tolerance: 1.0e-6,
             max_iterations: 1000,
             alpha: 0.1,
-            cfl: 0.2,
+            cfl: 0.4,
             h_over_dx: 1.2,
         }
     }

@@ -315,7 +315,7 @@ fn net_compression(
 /// compressive by Δt ∂_a u_b ∂_b u_a at its end, and the next step's pressure answers that:
 /// the pressure lags the flow by half a step. In a vortex the lagging pressure gradient points
 /// half a step behind the centre of curvature and brakes the flow at a rate ∝ Δt|u|²/R²,
-/// independent of the viscosity: at CFL 0.2 the Taylor–Green vortex at 40 particles across lost
+/// independent of the viscosity: at CFL 0.24 the Taylor–Green vortex at 40 particles across lost
 /// 1% of its kinetic energy to it every 0.1 L/U (docs/accuracy.md, "The time lag of the
 /// projection"). At the midpoint the volume change over the drift cancels to second order and
 /// the pressure is the one of the time the velocity is applied at. The ∂_a u_b ∂_b u_a of u*

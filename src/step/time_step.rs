@@ -25,7 +25,7 @@ pub struct StepLength {
 /// Which condition sets Δt_max.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Limit {
-    /// Δt ≤ CFL h / max |u|.
+    /// Δt ≤ CFL dx / max |u|.
     Cfl,
     /// Δt ≤ C_ν h²/ν, with ν the largest viscosity of the scene's fluids.
     Viscous,
@@ -37,7 +37,7 @@ impl Limit {
     /// The condition in words, with its constant.
     pub fn describe(self) -> String {
         match self {
-            Limit::Cfl => "the CFL condition (solver.cfl × h / the largest fluid speed)".into(),
+            Limit::Cfl => "the CFL condition (solver.cfl × dx / the largest fluid speed)".into(),
             Limit::Viscous => format!(
                 "the viscous condition ({VISCOUS_NUMBER} h²/ν with the largest fluid viscosity)"
             ),
@@ -46,8 +46,8 @@ impl Limit {
     }
 }
 
-/// Largest stable Δt of particles `p` with smoothing length `h`: CFL, viscous and body-force
-/// limits, and the one that sets it. A CFL step far below the body-force step means the flow
+/// Largest stable Δt of particles `p` with smoothing length `h`: CFL (on the particle spacing),
+/// viscous and body-force limits, and the one that sets it. A CFL step far below the body-force step means the flow
 /// has blown up: that is reported, not integrated (without gravity there is no such
 /// reference, and only a non-finite velocity stops the run).
 pub fn limiting<const D: usize>(
@@ -57,7 +57,10 @@ pub fn limiting<const D: usize>(
 ) -> Result<(f64, Limit), StepError> {
     let max_speed = p.max_fluid_speed();
     let g = set.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
-    let (cfl, body_force) = (set.cfl * h / max_speed, BODY_FORCE_NUMBER * (h / g).sqrt());
+    let (cfl, body_force) = (
+        set.cfl * set.spacing / max_speed,
+        BODY_FORCE_NUMBER * (h / g).sqrt(),
+    );
     let viscous = VISCOUS_NUMBER * h * h / set.max_viscosity;
     let dt = cfl.min(body_force).min(viscous);
     if body_force.is_finite() && cfl < COLLAPSE_FRACTION * body_force {
