@@ -523,6 +523,35 @@ fn sigterm_stops_a_run_with_a_checkpoint_it_resumes_from() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// A flow without gravity that blows up stops on a collapsed time step, measured against the
+/// viscous step: the Taylor–Green vortex at L/20 (viscous step 0.045 s) with one particle of its
+/// checkpoint set moving at 10⁴ m/s, whose CFL step (2e-6 s) is below a thousandth of it. With
+/// the body-force step as the only reference, such a run crept on at steps of 1e-8 s and less.
+#[test]
+fn a_gravity_free_flow_that_blows_up_stops_on_a_collapsed_time_step() {
+    let dir = TempDir::new("ckpt-collapse");
+    let edits = [("spacing = 0.02", "spacing = 0.05")];
+    let file = scene_file(dir.path(), "taylor_green_2d.toml", &edits, 0.1, 2);
+    let scene = Scene::load(&file).unwrap();
+    let out = dir.path().join("out");
+    run::run(&scene, &run_options(&out, 0.1)).unwrap();
+    let newest = newest_checkpoint(&out);
+    let checkpoint = Checkpoint::open(&newest).unwrap();
+    let mut p = Particles::<2>::default();
+    checkpoint.restore(&mut p).unwrap();
+    p.vel[0][0] = 1.0e4;
+    let folder = checkpoint_folder::folder(&out);
+    checkpoint_folder::save(&folder, &checkpoint.state, &mut p, 2).unwrap();
+
+    let located = resume::locate(&out).unwrap();
+    let e = run::resume(&located.checkpoint, &resume_options(0.1001)).unwrap_err();
+    let message = e.to_string();
+    assert!(
+        matches!(e, RunError::Numerical { .. }) && message.contains("time step collapsed"),
+        "{message}"
+    );
+}
+
 #[test]
 fn a_numerical_failure_names_the_newest_checkpoint() {
     let dir = TempDir::new("ckpt-failure");

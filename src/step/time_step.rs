@@ -8,7 +8,8 @@ use crate::particles::Particles;
 const VISCOUS_NUMBER: f64 = 0.125;
 /// Body-force time-step limit Δt ≤ C_g √(h/|g|).
 const BODY_FORCE_NUMBER: f64 = 0.25;
-/// A CFL time step below this fraction of the body-force step is a blow-up.
+/// A CFL time step below this fraction of the body-force or viscous step (the smaller) is a
+/// blow-up.
 const COLLAPSE_FRACTION: f64 = 1.0e-3;
 
 /// The length of a step and the limit it was cut from.
@@ -47,9 +48,10 @@ impl Limit {
 }
 
 /// Largest stable Δt of particles `p` with smoothing length `h`: CFL (on the particle spacing),
-/// viscous and body-force limits, and the one that sets it. A CFL step far below the body-force step means the flow
-/// has blown up: that is reported, not integrated (without gravity there is no such
-/// reference, and only a non-finite velocity stops the run).
+/// viscous and body-force limits, and the one that sets it. A CFL step far below the smaller of
+/// the body-force and viscous steps means the flow has blown up: that is reported, not
+/// integrated at ever smaller steps (without gravity the viscous step is the reference; an
+/// inviscid flow without gravity has none, and only a non-finite velocity stops it).
 pub fn limiting<const D: usize>(
     p: &Particles<D>,
     h: f64,
@@ -63,7 +65,8 @@ pub fn limiting<const D: usize>(
     );
     let viscous = VISCOUS_NUMBER * h * h / set.max_viscosity;
     let dt = cfl.min(body_force).min(viscous);
-    if body_force.is_finite() && cfl < COLLAPSE_FRACTION * body_force {
+    let reference = body_force.min(viscous);
+    if reference.is_finite() && cfl < COLLAPSE_FRACTION * reference {
         return Err(StepError::Collapse { dt, max_speed });
     }
     let limit = if dt == cfl {
