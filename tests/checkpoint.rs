@@ -328,6 +328,23 @@ fn newest_checkpoint(out: &Path) -> PathBuf {
     all.last().unwrap().1.clone()
 }
 
+/// Rewrites the newest checkpoint of the 2D run in `out` with its particles changed by
+/// `change` (the folder keeping `keep`); returns its path and the checkpoint as it was.
+fn rewrite_newest_checkpoint(
+    out: &Path,
+    keep: usize,
+    change: impl FnOnce(&mut Particles<2>),
+) -> (PathBuf, Checkpoint) {
+    let newest = newest_checkpoint(out);
+    let checkpoint = Checkpoint::open(&newest).unwrap();
+    let mut p = Particles::<2>::default();
+    checkpoint.restore(&mut p).unwrap();
+    change(&mut p);
+    let folder = checkpoint_folder::folder(out);
+    checkpoint_folder::save(&folder, &checkpoint.state, &mut p, keep).unwrap();
+    (newest, checkpoint)
+}
+
 /// Damages the newest checkpoint of a copy of `base` and resumes it: refused with `expected`
 /// in the message, and no file of the run changed.
 fn assert_damage_refused(
@@ -535,13 +552,7 @@ fn a_gravity_free_flow_that_blows_up_stops_on_a_collapsed_time_step() {
     let scene = Scene::load(&file).unwrap();
     let out = dir.path().join("out");
     run::run(&scene, &run_options(&out, 0.1)).unwrap();
-    let newest = newest_checkpoint(&out);
-    let checkpoint = Checkpoint::open(&newest).unwrap();
-    let mut p = Particles::<2>::default();
-    checkpoint.restore(&mut p).unwrap();
-    p.vel[0][0] = 1.0e4;
-    let folder = checkpoint_folder::folder(&out);
-    checkpoint_folder::save(&folder, &checkpoint.state, &mut p, 2).unwrap();
+    rewrite_newest_checkpoint(&out, 2, |p| p.vel[0][0] = 1.0e4);
 
     let located = resume::locate(&out).unwrap();
     let e = run::resume(&located.checkpoint, &resume_options(0.1001)).unwrap_err();
@@ -560,14 +571,10 @@ fn a_numerical_failure_names_the_newest_checkpoint() {
     run::run(&scene, &run_options(&out, 2.0 * scene.output_interval)).unwrap();
     // The newest checkpoint, rewritten with a fluid particle far outside the domain: the next
     // step finds it there.
-    let newest = newest_checkpoint(&out);
-    let checkpoint = Checkpoint::open(&newest).unwrap();
-    let mut p = Particles::<2>::default();
-    checkpoint.restore(&mut p).unwrap();
-    let fluid = p.kind.iter().position(|&k| k == Kind::Fluid).unwrap();
-    p.pos[0][fluid] = 1.0e3;
-    let folder = checkpoint_folder::folder(&out);
-    checkpoint_folder::save(&folder, &checkpoint.state, &mut p, 3).unwrap();
+    let (newest, checkpoint) = rewrite_newest_checkpoint(&out, 3, |p| {
+        let fluid = p.kind.iter().position(|&k| k == Kind::Fluid).unwrap();
+        p.pos[0][fluid] = 1.0e3;
+    });
     let rows = crate::common::stats_column(&out, "step").len();
 
     let located = resume::locate(&out).unwrap();
