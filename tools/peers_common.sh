@@ -12,7 +12,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
   "$VENV/bin/pip" install -q "pysplishsplash==2.19.0"
 fi
-python3 -c "import h5py, numpy, matplotlib" 2>/dev/null || python3 -m pip install -q h5py numpy matplotlib
+python3 -c "import h5py, numpy" 2>/dev/null || python3 -m pip install -q h5py numpy
 if [ ! -x "$ISPH" ]; then
   (cd "$ROOT" && cargo build --release)
 fi

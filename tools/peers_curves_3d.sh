@@ -26,6 +26,7 @@ SOLVERS=${SOLVERS:-"DFSPH IISPH"}
 mkdir -p "$WORK"
 
 . "$ROOT/tools/peers_common.sh"
+python3 -c "import matplotlib" 2>/dev/null || python3 -m pip install -q matplotlib
 
 CSV="$WORK/curves.csv"
 echo "round,code,setting,steps,iterations_mean,wall_per_sim_second,compression_mean" > "$CSV"
@@ -42,10 +43,10 @@ for round in $(seq 1 "$ROUNDS"); do
     isph_scene "$setting" "$WORK/isph_$k.toml"
     run_isph "$WORK/isph_$k.toml" "$WORK/isph_$k" "$WORK/isph_$k.log"
     python3 "$ROOT/tools/peers_curves.py" isph "$round" "$setting" "$WORK/isph_$k" "$WORK/isph_$k.toml" >> "$CSV"
+    # SPlisHSPlasH's k-th tolerance after isph's k-th setting, so the codes alternate.
+    [ "$k" -lt "${#ERRORS[@]}" ] || continue
+    maxerror=${ERRORS[$k]}
     for SOLVER in $SOLVERS; do
-      # SPlisHSPlasH's k-th tolerance after isph's k-th setting, so the codes alternate.
-      [ "$k" -lt "${#ERRORS[@]}" ] || continue
-      maxerror=${ERRORS[$k]}
       echo "round $round: SPlisHSPlasH $SOLVER at $maxerror% ..."
       line=$(run_splash "$SOLVER" "$maxerror" "$WORK/splash_$SOLVER" "$WORK/splash_$SOLVER.log")
       python3 "$ROOT/tools/peers_curves.py" splash "$round" "$maxerror%" "$line" >> "$CSV"
