@@ -62,14 +62,14 @@ fn read(path: &Path, p: &mut Particles<3>) {
 fn bench(c: &mut Criterion, n: usize) {
     let dir = std::env::temp_dir().join(format!("isph-bench-checkpoint-{}", std::process::id()));
     let mut p = particles(n);
-    let path = checkpoint_folder::save(&dir, &state(), &mut p, 1).unwrap();
+    let path = checkpoint_folder::save(&dir, &state(), &mut p, &[], 1).unwrap();
     let bytes = std::fs::metadata(&path).unwrap().len();
     let mut g = c.benchmark_group(format!("checkpoint_3d_{n}_particles"));
     g.sample_size(10)
         .measurement_time(Duration::from_secs(10))
         .throughput(Throughput::Bytes(bytes));
     g.bench_function("write (fsync, rename)", |b| {
-        b.iter(|| checkpoint_folder::save(&dir, &state(), &mut p, 1).unwrap())
+        b.iter(|| checkpoint_folder::save(&dir, &state(), &mut p, &[], 1).unwrap())
     });
     g.bench_function("read (page cache)", |b| b.iter(|| read(&path, &mut p)));
     g.bench_function("read (from disk)", |b| {

@@ -5,13 +5,14 @@
 //! [`run()`] drives a whole run with its output and checkpoints, and [`resume()`] continues one.
 //!
 //! The layers, lowest first (a module imports only from its own folder and the layers before
-//! it; `tests/layering.rs` holds this): [`math`], [`scene`], [`particles`], [`neighbours`],
+//! it; `tests/layering.rs` holds this): [`math`], [`scene`], [`particles`], [`bodies`], [`neighbours`],
 //! [`boundary`], [`sph`], [`solver`], `effects`, [`fill`], [`surface`], [`io`], `step`,
 //! [`simulation`], [`run`], [`render`], [`tools`].
 
 // Axis and tensor loops index several arrays by the same d (or a, b), as the equations do.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bodies;
 pub mod boundary;
 pub(crate) mod effects;
 pub mod fill;

@@ -10,12 +10,25 @@ pub enum Kind {
     Fluid = 0,
     /// Fixed dummy wall particle (container walls and obstacles).
     Wall = 1,
+    /// A particle of a rigid body (`bodies`): sorted and paired as fluid, since the pressure
+    /// solve treats it as fluid of the body's density (Eq. 11–16), then moved rigidly.
+    Body = 2,
 }
 
 impl Kind {
+    /// The kind the cell sort groups the particle with (`cell_list::KINDS`): a body's
+    /// particles go with the fluid, whose operators they take part in.
+    #[inline]
+    pub fn sorted_as(self) -> Kind {
+        match self {
+            Kind::Fluid | Kind::Body => Kind::Fluid,
+            Kind::Wall => Kind::Wall,
+        }
+    }
+
     /// The kind whose `as u8` code is `code` (how checkpoints store it).
     pub fn from_code(code: u8) -> Option<Kind> {
-        [Kind::Fluid, Kind::Wall]
+        [Kind::Fluid, Kind::Wall, Kind::Body]
             .into_iter()
             .find(|k| *k as u8 == code)
     }
@@ -42,6 +55,8 @@ pub struct Particles<const D: usize> {
     /// How the last pressure solve saw the particle (0 interior or wall, 1 free surface,
     /// 2 splash): written to the frames for inspection, not used by the step.
     pub free_surface: Vec<u8>,
+    /// The index of a fluid particle's fluid in the scene, of a body particle's body; NO_FLUID
+    /// for walls.
     pub fluid: Vec<u16>,
     pub id: Vec<u64>,
 }
@@ -156,10 +171,10 @@ impl<const D: usize> Particles<D> {
             .sqrt()
     }
 
-    /// The largest speed of the fluid particles (thread-count independent).
+    /// The largest speed of the fluid and body particles (thread-count independent).
     pub fn max_fluid_speed(&self) -> f64 {
         reduce::max(self.len(), |i| {
-            if self.is_fluid(i) {
+            if self.kind[i] != Kind::Wall {
                 self.speed(i)
             } else {
                 0.0

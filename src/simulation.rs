@@ -1,6 +1,7 @@
 //! The state of a run and its time stepping: the particles, the simulated time and the step
 //! count (what a checkpoint holds), advanced by the stages of `step`.
 
+use crate::bodies::Bodies;
 use crate::boundary::faces::Faces;
 use crate::fill;
 use crate::io::stats::StepStats;
@@ -54,6 +55,8 @@ pub struct NoFluid {
 pub struct Simulation<const D: usize> {
     /// The lasting state: what a checkpoint holds, with `time` and `step`.
     pub particles: Particles<D>,
+    /// The rigid bodies' state (empty: none), advanced with the particles.
+    pub bodies: Bodies,
     pub time: f64,
     pub step: u64,
     /// The stages of a step and their scratch.
@@ -70,13 +73,15 @@ impl<const D: usize> Simulation<D> {
             scene.dimensions, D,
             "scene dimension and solver dimension differ"
         );
-        let particles = fill::build::<D>(scene);
+        let mut particles = fill::build::<D>(scene);
         if particles.fluid_count() == 0 {
             return Err(NoFluid {
                 path: scene.path.clone(),
             });
         }
         let confined = fill::fills_container(scene, &particles);
+        let bodies = Bodies::new(scene, &particles);
+        bodies.set_particle_velocities(&mut particles);
         let h = scene.smoothing_length();
         // Bounded axes: room for the wall layers and a spacing more; a periodic axis is one
         // period, the container's extent.
@@ -113,11 +118,13 @@ impl<const D: usize> Simulation<D> {
             Faces::new(&scene.container, &scene.periodic, &scene.obstacles),
             CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
             interfaces,
+            !bodies.is_empty(),
         );
         let timings = Timings::new(stepper.stages().iter().map(|s| s.name()));
         let c = &scene.container;
         Ok(Self {
             particles,
+            bodies,
             time: 0.0,
             step: 0,
             stepper,
@@ -173,6 +180,7 @@ impl<const D: usize> Simulation<D> {
     ) -> Result<StepStats, NumericalFailure> {
         let report = self.stepper.advance(
             &mut self.particles,
+            &mut self.bodies,
             self.time,
             target,
             &mut self.timings,

@@ -354,3 +354,23 @@ fn the_progress_line_shows_the_end_time_as_written() {
     assert!(line.contains("/0.3 s |"), "{line}");
     assert!(!stderr.contains("0.30000000000000004"), "{stderr}");
 }
+
+#[test]
+fn each_bad_body_is_refused_with_its_key() {
+    let dir = TempDir::new("bad-bodies");
+    let body = |text: &str| format!("{}\n[[body]]\n{text}\n", good());
+    let cases: &[(&str, &[&str])] = &[
+        ("shape = \"box\"\nmin = [0.3, 0.1]\nmax = [0.5, 0.2]\ndensity = 500.0", &["body[0].shape", "not inside the container"]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0\n[[body]]\nshape = \"circle\"\ncenter = [0.15, 0.1]\nradius = 0.05\ndensity = 500.0", &["body[1].shape", "overlaps body[0]"]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = -1.0", &["body[0].density", "positive"]),
+        ("shape = \"cone\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0", &["body[0].shape", "\"cone\" is not a shape", "\"circle\""]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0\nmotion = \"wobbly\"", &["body[0].motion", "\"free\""]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\ndensity = 500.0", &["body[0].radius", "missing"]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\nmin = [0.0, 0.0]\ndensity = 500.0", &["body[0].min", "not a key of a circle"]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05", &["body[0]", "neither `density`"]),
+    ];
+    for (text, expected) in cases {
+        let (code, stderr) = run_text(dir.path(), &body(text), &[]);
+        assert_refused(code, &stderr, expected);
+    }
+}

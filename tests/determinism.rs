@@ -29,6 +29,11 @@ fn assert_thread_count_independent(name: &str, scene: &Scene, until: f64, frames
             );
         }
     }
+    let bodies = |dir: &TempDir| std::fs::read(dir.path().join("bodies.csv")).ok();
+    assert!(
+        bodies(&dirs[0]) == bodies(&dirs[1]),
+        "{name}: bodies.csv differs between 1 and 2 threads"
+    );
     let probes = |dir: &TempDir| std::fs::read(dir.path().join("probes.csv")).ok();
     assert_eq!(
         probes(&dirs[0]),
@@ -58,6 +63,23 @@ fn one_and_two_threads_write_bit_identical_frames() {
     scene.output_interval = 0.01;
     scene.probes = dam_break_probes();
     assert_thread_count_independent("dam-break", &scene, 0.03, 3);
+}
+
+/// Bodies: their sums run in the sorted order on one thread.
+#[test]
+fn a_floating_and_a_sinking_body_are_bit_identical_on_one_and_two_threads() {
+    let mut scene = shipped_scene("floating_box_2d.toml");
+    scene.spacing = 0.02;
+    scene.output_interval = 0.05;
+    let mut sinker = scene.bodies[0].clone();
+    sinker.name = "sinker".into();
+    sinker.shape = isph::scene::Shape::Ball {
+        center: vec![0.2, 0.15],
+        radius: 0.06,
+    };
+    sinker.mass = isph::scene::BodyMass::Density(1500.0);
+    scene.bodies.push(sinker);
+    assert_thread_count_independent("bodies", &scene, 0.2, 4);
 }
 
 /// A periodic, confined flow: the wrapped neighbour search, the reference pressure and the

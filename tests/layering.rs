@@ -11,6 +11,10 @@ const RULES: &[(&str, &[&str])] = &[
     ("math", &[]),
     ("scene", &["math"]),
     ("particles", &["math"]),
+    (
+        "bodies",
+        &["math", "scene::BodyMotion", "scene::Scene", "particles"],
+    ),
     ("neighbours", &["math", "particles"]),
     ("boundary", &["math", "particles", "neighbours"]),
     ("sph", &["math", "particles", "neighbours", "boundary"]),
@@ -45,6 +49,7 @@ const RULES: &[(&str, &[&str])] = &[
             "scene::ShiftingSettings",
             "scene::LesSettings",
             "particles",
+            "bodies",
             "neighbours",
             "boundary",
             "sph",
@@ -63,7 +68,7 @@ const RULES: &[(&str, &[&str])] = &[
         ],
     ),
     // io never imports the step or the solver.
-    ("io", &["math", "scene", "particles", "surface"]),
+    ("io", &["math", "scene", "particles", "bodies", "surface"]),
     (
         "simulation",
         &[
@@ -71,6 +76,7 @@ const RULES: &[(&str, &[&str])] = &[
             "scene",
             "fill",
             "particles",
+            "bodies",
             "neighbours",
             "boundary",
             "sph",
@@ -85,6 +91,7 @@ const RULES: &[(&str, &[&str])] = &[
             "math",
             "scene",
             "particles",
+            "bodies",
             "simulation",
             "step::timings",
             "surface",
@@ -100,6 +107,7 @@ const RULES: &[(&str, &[&str])] = &[
             "scene",
             "fill",
             "particles",
+            "bodies",
             "neighbours",
             "boundary",
             "sph",

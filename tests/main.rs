@@ -7,6 +7,7 @@ mod common;
 
 mod bad_input;
 mod bench;
+mod bodies;
 mod checkpoint;
 mod dam_break;
 mod determinism;

@@ -1,14 +1,16 @@
 //! Initial particles on a lattice of spacing dx anchored at the container's lower corner:
-//! fluid blocks, the container's dummy wall layers and solid obstacles. The fluid particles
+//! fluid blocks, the container's dummy wall layers, solid obstacles and rigid bodies. The fluid particles
 //! are moved off their lattice points by a small deterministic perturbation
 //! (`simulation.perturbation`, `perturbed`).
 
 use crate::boundary::faces::Faces;
 use crate::math::lattice::for_each_lattice_point;
 use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
-use crate::scene::{Block, Scene};
+use crate::scene::{Block, BodyMass, Scene};
 
-/// Particles of the scene at t = 0: fluid first (in block order), then walls.
+/// Particles of the scene at t = 0: fluid first (in block order), then walls, then each body's
+/// particles (in the order of the scene's bodies, so that a body's ids are contiguous). No
+/// fluid starts inside a body or within half a spacing of it.
 pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let dx = scene.spacing;
     let volume = dx.powi(D as i32);
@@ -16,12 +18,12 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let cells = container_cells::<D>(scene);
     let point = |k: [i64; D]| lattice_point(scene, k);
     let in_obstacle = |x: &[f64; D]| in_obstacle(scene, x);
-    let near_obstacle = |x: &[f64; D]| near_obstacle(scene, x);
+    let kept_clear = |x: &[f64; D]| near_obstacle(scene, x) || near_body(scene, x);
 
     let mut particles = Particles::<D>::default();
     for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
         let x = point(k);
-        if let (Some(b), false) = (block_of(scene, &x), near_obstacle(&x)) {
+        if let (Some(b), false) = (block_of(scene, &x), kept_clear(&x)) {
             let fluid = &scene.fluids[b.fluid];
             particles.push(NewParticle {
                 pos: perturbed(x, k, scene.perturbation * dx),
@@ -70,7 +72,62 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
             particles.push(wall(x));
         }
     });
+    for (b, body) in scene.bodies.iter().enumerate() {
+        let mut points = Vec::new();
+        for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
+            let x = point(k);
+            if body.shape.contains(&x) {
+                points.push(x);
+            }
+        });
+        let mass = match body.mass {
+            BodyMass::Density(density) => density * volume,
+            BodyMass::Total(mass) => mass / points.len() as f64,
+        };
+        for x in points {
+            particles.push(NewParticle {
+                pos: x,
+                kind: Kind::Body,
+                normal: [0.0; D],
+                fluid: b as u16,
+                mass,
+                rest_density: mass / volume,
+                viscosity: scene.fluids[0].viscosity,
+            });
+        }
+    }
     particles
+}
+
+/// How many lattice points of the fluid blocks each body keeps clear of fluid (inside it or
+/// within half a spacing of it, and clear of the obstacles and of the bodies before it).
+pub fn displaced_by_bodies<const D: usize>(scene: &Scene) -> Vec<usize> {
+    let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
+    let mut displaced = vec![0; scene.bodies.len()];
+    for_each_lattice_point([0; D], container_cells::<D>(scene), |k| {
+        let x = lattice_point(scene, k);
+        if block_of(scene, &x).is_none() || near_obstacle(scene, &x) {
+            return;
+        }
+        let first = scene
+            .bodies
+            .iter()
+            .position(|b| b.shape.signed_distance(&x) < margin);
+        if let Some(b) = first {
+            displaced[b] += 1;
+        }
+    });
+    displaced
+}
+
+/// Whether x lies inside a body or less than half a spacing outside it: no fluid particle
+/// starts there (as at an obstacle, `near_obstacle`).
+fn near_body<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
+    let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
+    scene
+        .bodies
+        .iter()
+        .any(|b| b.shape.signed_distance(x) < margin)
 }
 
 /// The block lattice point x belongs to: the first that holds it strictly inside. A point on
@@ -103,13 +160,14 @@ fn block_of<'a, const D: usize>(scene: &'a Scene, x: &[f64; D]) -> Option<&'a Bl
     (2 * covered > 1 << D).then_some(on_face)
 }
 
-/// Whether the fluid fills the container: every lattice point inside it and outside the
-/// obstacles holds a fluid particle. Incompressible fluid that fills a closed or periodic box
+/// Whether the fluid fills the container: every lattice point inside it and clear of the
+/// obstacles and bodies holds a fluid particle. Incompressible fluid that fills a closed or periodic box
 /// has no free surface, and can never make one.
 pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) -> bool {
     let mut room = 0;
     for_each_lattice_point([0; D], container_cells::<D>(scene), |k| {
-        room += !near_obstacle(scene, &lattice_point(scene, k)) as usize;
+        let x = lattice_point(scene, k);
+        room += !(near_obstacle(scene, &x) || near_body(scene, &x)) as usize;
     });
     particles.fluid_count() == room
 }

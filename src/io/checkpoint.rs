@@ -5,6 +5,7 @@
 //! checksum, table) before anything is used; each array is then copied once, straight from the
 //! mapped pages into the particle vector.
 
+use crate::bodies::{Bodies, RigidState};
 use crate::particles::{ArrayMut, Kind, Particles};
 use memmap2::{Mmap, MmapOptions};
 use std::borrow::Cow;
@@ -29,6 +30,9 @@ const ENTRY_LEN: usize = 48;
 const NAME_LEN: usize = 24;
 /// The checksum covers the file from this offset (just after the checksum field) to its end.
 const CHECKSUMMED_FROM: usize = 24;
+/// The array of the rigid bodies' states (`RigidState::to_array`, one after the other), in a
+/// run with bodies only; the one array whose length is not the particle count.
+const BODIES: &str = "bodies";
 
 /// What a continued run needs besides the particle arrays.
 #[derive(Clone, Debug, PartialEq)]
@@ -168,13 +172,13 @@ fn head(
     state: &RunState,
     dims: usize,
     count: usize,
-    arrays: &[(&str, ElementType)],
+    arrays: &[(&str, ElementType, usize)],
 ) -> (Vec<u8>, Vec<Entry>) {
     let path = state.scene_path.as_os_str().as_bytes();
     let path_at = HEADER_LEN + ENTRY_LEN * arrays.len();
     let data_start = align_up(path_at + path.len());
     let mut entries: Vec<Entry> = Vec::with_capacity(arrays.len());
-    for &(name, element) in arrays {
+    for &(name, element, length) in arrays {
         // Names are constants of `Particles::arrays_mut`: a longer one is a programming error.
         assert!(
             name.len() <= NAME_LEN,
@@ -185,7 +189,7 @@ fn head(
             name: name.to_owned(),
             element,
             offset,
-            length: count,
+            length,
         });
     }
     let file_length = entries.last().map_or(data_start, Entry::end);
@@ -233,23 +237,29 @@ fn array_chunks<'a>(
         .flat_map(|((entry, end), bytes)| [&ZEROS[..entry.offset - end], &bytes[..]])
 }
 
-/// Writes the checkpoint of `state` and `p` into `file` (empty, positioned at its start).
+/// Writes the checkpoint of `state`, `p` and the bodies' states `bodies`
+/// (`Bodies::states`, empty without bodies) into `file` (empty, positioned at its start).
 /// `p` is borrowed mutably only because `Particles::arrays_mut` is the one list of its arrays;
 /// nothing in it changes.
 pub fn write<const D: usize>(
     file: &mut File,
     state: &RunState,
     p: &mut Particles<D>,
+    bodies: &[f64],
 ) -> std::io::Result<()> {
     let count = p.len();
     let arrays = p.arrays_mut();
     let stored: Vec<_> = arrays.iter().map(|(_, a)| stored_bytes(a)).collect();
-    let table: Vec<_> = arrays
+    let mut table: Vec<_> = arrays
         .iter()
         .zip(&stored)
-        .map(|((name, _), (element, _))| (*name, *element))
+        .map(|((name, _), (element, _))| (*name, *element, count))
         .collect();
-    let bytes: Vec<Cow<[u8]>> = stored.into_iter().map(|(_, b)| b).collect();
+    let mut bytes: Vec<Cow<[u8]>> = stored.into_iter().map(|(_, b)| b).collect();
+    if !bodies.is_empty() {
+        table.push((BODIES, ElementType::F64, bodies.len()));
+        bytes.push(Cow::Borrowed(bytemuck::cast_slice(bodies)));
+    }
     let (mut head, entries) = head(state, D, count, &table);
 
     let mut hasher = Xxh3::new();
@@ -358,7 +368,7 @@ impl Checkpoint {
         if let Some(extra) = self
             .entries
             .iter()
-            .find(|e| !arrays.iter().any(|(name, _)| *name == e.name))
+            .find(|e| e.name != BODIES && !arrays.iter().any(|(name, _)| *name == e.name))
         {
             return Err(mismatch(format!(
                 "it holds an array `{}` this isph does not know",
@@ -400,6 +410,35 @@ impl Checkpoint {
                 path: self.path.clone(),
                 what: "its particle ids are not 0, 1, …, N−1 in some order".into(),
             });
+        }
+        Ok(())
+    }
+}
+
+impl Checkpoint {
+    /// Restores the states of `bodies` (those of the run's scene): refused if the checkpoint
+    /// holds no state for each of them, or holds states where the scene has no body.
+    pub fn restore_bodies(&self, bodies: &mut Bodies) -> Result<(), CheckpointError> {
+        let mismatch = |what: String| CheckpointError::Mismatch {
+            path: self.path.clone(),
+            what,
+        };
+        let entry = self.entries.iter().find(|e| e.name == BODIES);
+        let states: Vec<f64> = match entry {
+            Some(e) if e.element == ElementType::F64 => {
+                let mut states = Vec::new();
+                replace(&mut states, &self.map[e.offset..e.end()]);
+                states
+            }
+            Some(_) => return Err(mismatch(format!("its array `{BODIES}` does not hold f64"))),
+            None => Vec::new(),
+        };
+        if !bodies.restore(&states) {
+            return Err(mismatch(format!(
+                "it holds the states of {} bodies, the scene has {}",
+                states.len() / RigidState::LEN,
+                bodies.bodies.len()
+            )));
         }
         Ok(())
     }
@@ -478,7 +517,7 @@ fn parse_layout(b: &[u8]) -> Result<Layout, String> {
         let starts_after = entries.last().map_or(data_start, Entry::end);
         if entry.offset % ALIGN != 0
             || entry.offset < starts_after
-            || entry.length != count
+            || (entry.length != count && entry.name != BODIES)
             || entry
                 .length
                 .checked_mul(element.size())

@@ -58,6 +58,7 @@ pub fn save<const D: usize>(
     dir: &Path,
     state: &RunState,
     p: &mut Particles<D>,
+    bodies: &[f64],
     keep: usize,
 ) -> Result<PathBuf, CheckpointError> {
     let path = dir.join(file_name(state.step));
@@ -72,7 +73,7 @@ pub fn save<const D: usize>(
         }
     }
     let tmp = dir.join(format!(".{}{PARTIAL}", file_name(state.step)));
-    if let Err(e) = write_synced(&tmp, state, p) {
+    if let Err(e) = write_synced(&tmp, state, p, bodies) {
         // Do not leave a partial file taking the room (a full disk is the likely cause).
         let _ = std::fs::remove_file(&tmp);
         return Err(write_error(e));
@@ -87,9 +88,10 @@ fn write_synced<const D: usize>(
     path: &Path,
     state: &RunState,
     p: &mut Particles<D>,
+    bodies: &[f64],
 ) -> io::Result<()> {
     let mut file = File::create(path)?;
-    checkpoint::write(&mut file, state, p)?;
+    checkpoint::write(&mut file, state, p, bodies)?;
     file.sync_all()
 }
 

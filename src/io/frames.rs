@@ -4,7 +4,7 @@
 //! read a frame without the scene). Written from one thread only.
 
 use super::OutputError;
-use crate::particles::{Particles, NO_FLUID};
+use crate::particles::{Kind, Particles};
 use crate::surface::Points;
 use std::path::{Path, PathBuf};
 
@@ -184,10 +184,17 @@ impl FrameWriter {
             .create("kind")?
             .write_raw(&ints(&|i| p.kind[i] as i32))?;
         let fluid = |i: usize| {
-            if p.fluid[i] == NO_FLUID {
+            if p.kind[i] != Kind::Fluid {
                 -1
             } else {
                 p.fluid[i] as i32
+            }
+        };
+        let body = |i: usize| {
+            if p.kind[i] == Kind::Body {
+                p.fluid[i] as i32
+            } else {
+                -1
             }
         };
         g.new_dataset::<i32>()
@@ -201,7 +208,7 @@ impl FrameWriter {
         g.new_dataset::<i32>()
             .shape(n)
             .create("body")?
-            .write_raw(&ints(&|_| -1))?;
+            .write_raw(&ints(&body))?;
         let ids: Vec<i64> = (0..n as i64).collect();
         g.new_dataset::<i64>()
             .shape(n)
@@ -222,9 +229,9 @@ pub struct Frame {
     pub velocity: Vec<[f64; 3]>,
     pub pressure: Vec<f64>,
     pub density: Vec<f64>,
-    /// 0 fluid, 1 wall (`particles::Kind` codes).
+    /// 0 fluid, 1 wall, 2 body (`particles::Kind` codes).
     pub kind: Vec<i32>,
-    /// Index into the scene's fluids; -1 for walls.
+    /// Index into the scene's fluids; -1 for walls and bodies.
     pub fluid: Vec<i32>,
     /// The PPE role of each fluid particle: 0 interior, 1 free surface, 2 spray
     /// (`ppe::Role::code`); 0 for walls.

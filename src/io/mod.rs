@@ -1,6 +1,7 @@
 //! Run output: HDF5 frames with their XDMF index, the per-step `stats.csv`, checkpoints, and
 //! the output directory itself (never overwritten by accident).
 
+pub mod bodies_csv;
 pub mod checkpoint;
 pub mod checkpoint_folder;
 pub mod csv;

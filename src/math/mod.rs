@@ -1,6 +1,6 @@
 //! The mathematics every layer shares, which knows nothing of particles or scenes: small
 //! vectors, SIMD lanes, thread-count-independent parallel loops and sums, the kernel of Eq. (19),
-//! the walk over lattice points, and the sizes of arrays.
+//! the walk over lattice points, the sizes of arrays, rotations and the shapes of bodies.
 
 pub(crate) mod aabb;
 pub mod kernel;
@@ -8,4 +8,6 @@ pub mod lanes;
 pub(crate) mod lattice;
 pub mod memory;
 pub mod reduce;
+pub mod rotation;
+pub mod shape;
 pub mod vector;

@@ -53,7 +53,7 @@ impl Slab {
 }
 
 /// The kinds of particle the sort groups, in index order: every kind's particles follow those
-/// of the kinds before it.
+/// of the kinds before it. Body particles are grouped with the fluid (`Kind::sorted_as`).
 pub const KINDS: [Kind; 2] = [Kind::Fluid, Kind::Wall];
 
 #[derive(Clone, Debug)]
@@ -186,7 +186,7 @@ impl<const D: usize> CellList<D> {
 
     /// The index range of the particles of `kind` (after `sort`).
     pub fn range_of(&self, kind: Kind) -> Range<usize> {
-        let (n, k) = (self.cell_count(), kind as usize);
+        let (n, k) = (self.cell_count(), kind.sorted_as() as usize);
         self.cell_start[k * n] as usize..self.cell_start[(k + 1) * n] as usize
     }
 
@@ -229,7 +229,7 @@ impl<const D: usize> CellList<D> {
         if let Some(index) = cell_of.iter().position(|&c| c == u32::MAX) {
             return Err(OutsideGrid { index });
         }
-        let key = |i: usize| kind[i] as usize * ncells + cell_of[i] as usize;
+        let key = |i: usize| kind[i].sorted_as() as usize * ncells + cell_of[i] as usize;
         self.cell_start.fill(0);
         for i in 0..n {
             self.cell_start[key(i) + 1] += 1;

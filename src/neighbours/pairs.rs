@@ -41,7 +41,8 @@ pub struct Lanes<const D: usize> {
     pub r: F64s,
     /// All bits set in the lanes that are neighbours (inside the support, j ≠ i), zero elsewhere.
     pub mask: F64s,
-    /// The kind of the candidates (a range holds particles of one kind).
+    /// The kind of the candidates (a range holds particles of one kind), as the sort groups
+    /// them (`Kind::sorted_as`): `Fluid` for fluid and body particles, or `Wall`.
     pub kind: Kind,
 }
 

@@ -7,6 +7,7 @@ pub(crate) mod progress;
 pub mod resume;
 mod stop;
 
+use crate::io::bodies_csv::BodiesWriter;
 use crate::io::checkpoint::{Checkpoint, CheckpointError, RunState};
 use crate::io::checkpoint_folder;
 use crate::io::frames::{FrameInfo, FrameWriter};
@@ -141,6 +142,11 @@ fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary
         } else {
             Some(ProbesWriter::create(&opts.out, &scene.probes)?)
         },
+        bodies: if scene.bodies.is_empty() {
+            None
+        } else {
+            Some(BodiesWriter::create(&opts.out)?)
+        },
     };
     let mut driver = Driver::new(scene, sim, output, None, opts.until, opts.quiet, &opts.stop);
     // Frame 0: the initial state.
@@ -165,6 +171,7 @@ fn resume_in<const D: usize>(
     let start = resume::prepare(checkpoint, opts)?;
     let mut sim = Simulation::<D>::new(&start.scene)?;
     checkpoint.restore(&mut sim.particles)?;
+    checkpoint.restore_bodies(&mut sim.bodies)?;
     sim.time = checkpoint.state.time;
     sim.step = checkpoint.state.step;
     Driver::new(
@@ -298,6 +305,10 @@ impl<'a, const D: usize> Driver<'a, D> {
             .write(index, &self.sim.particles, self.sim.time, self.sim.step)?;
         o.frames.push(frame);
         xdmf::write(&o.dir, &o.frames)?;
+        if let Some(bodies) = &mut o.bodies {
+            bodies.rows(self.sim.time, &self.sim.bodies)?;
+            bodies.flush()?;
+        }
         if let Some((writer, settings)) = &mut o.surfaces {
             let points = output::fluid_points(&self.sim.particles, self.scene.spacing);
             // A surface that cannot be built (the fluid spread over more cubes than allowed)
@@ -342,6 +353,9 @@ impl<'a, const D: usize> Driver<'a, D> {
         if let Some(probes) = &mut self.output.probes {
             probes.sync()?;
         }
+        if let Some(bodies) = &mut self.output.bodies {
+            bodies.sync()?;
+        }
         self.output.frames_out.sync()?;
         let scene_path =
             std::path::absolute(&self.scene.path).unwrap_or_else(|_| self.scene.path.clone());
@@ -359,6 +373,7 @@ impl<'a, const D: usize> Driver<'a, D> {
             &checkpoint_folder::folder(&self.output.dir),
             &state,
             &mut self.sim.particles,
+            &self.sim.bodies.states(),
             self.scene.checkpoint.keep,
         )?;
         let saved = Saved {

@@ -1,5 +1,6 @@
 //! The files of a run's output directory, open for appending.
 
+use crate::io::bodies_csv::BodiesWriter;
 use crate::io::frames::{FrameInfo, FrameWriter};
 use crate::io::probes::ProbesWriter;
 use crate::io::stats::StatsWriter;
@@ -19,6 +20,8 @@ pub(crate) struct Output {
     pub surfaces: Option<(SurfaceWriter, SurfaceSettings)>,
     /// `[[probe]]`: probes.csv (None: the scene has no probe).
     pub probes: Option<ProbesWriter>,
+    /// `[[body]]`: bodies.csv (None: the scene has no body).
+    pub bodies: Option<BodiesWriter>,
 }
 
 /// The fluid particles of `p` in id order, as a frame lists them: the surface built during a

@@ -2,6 +2,7 @@
 //! the checkpoint. Every check comes before the first change to a file, so a refused resume
 //! leaves the directory byte for byte as it was.
 
+use crate::io::bodies_csv::{self, BodiesWriter};
 use crate::io::checkpoint::{Checkpoint, CheckpointError, RunState};
 use crate::io::checkpoint_folder::{self, DIR_NAME};
 use crate::io::frames::{self, FrameWriter};
@@ -119,7 +120,7 @@ pub(crate) struct Continuation {
 
 /// Checks that `checkpoint` can be continued (its scene unchanged unless `force`, its run's
 /// frames and rows all there, a stop time after it), then cuts the run back to it: the
-/// checkpoints, frames and stats.csv and probes.csv rows after it are deleted, particles.xdmf is
+/// checkpoints, frames and stats.csv, probes.csv and bodies.csv rows after it are deleted, particles.xdmf is
 /// rewritten.
 pub(crate) fn prepare(
     checkpoint: &Checkpoint,
@@ -150,6 +151,12 @@ pub(crate) fn prepare(
     }
     let stats_length = stats::end_of_step(&out, state.step)?;
     let probes_file = probes_file(&out, &scene, state)?;
+    let bodies_length = if scene.bodies.is_empty() {
+        None
+    } else {
+        let frames = state.frames_written as usize;
+        Some(bodies_csv::end_of_frames(&out, frames, scene.bodies.len())?)
+    };
 
     // Every check has passed: from here on the run's future after the checkpoint is replaced.
     // particles.h5 is opened for writing first, so that if another program holds it, nothing
@@ -168,6 +175,9 @@ pub(crate) fn prepare(
         None => None,
     };
     let probes = continue_probes(&out, &scene, state, probes_file)?;
+    let bodies = bodies_length
+        .map(|length| BodiesWriter::append_at(&out, length))
+        .transpose()?;
     Ok(Continuation {
         scene,
         output: Output {
@@ -177,6 +187,7 @@ pub(crate) fn prepare(
             frames,
             surfaces,
             probes,
+            bodies,
         },
     })
 }

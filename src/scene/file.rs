@@ -28,6 +28,30 @@ pub(super) struct SceneFile {
     pub(super) output: OutputSection,
     #[serde(default)]
     pub(super) probe: Vec<ProbeSection>,
+    #[serde(default)]
+    pub(super) body: Vec<BodySection>,
+}
+
+/// `[[body]]` as written: the keys of every shape and motion, each optional here; `validate`
+/// asks for the ones the shape needs and refuses the others (docs/scene-format.md).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct BodySection {
+    pub(super) name: Option<String>,
+    pub(super) shape: String,
+    pub(super) min: Option<Vec<f64>>,
+    pub(super) max: Option<Vec<f64>>,
+    pub(super) center: Option<Vec<f64>>,
+    pub(super) radius: Option<f64>,
+    pub(super) axis: Option<String>,
+    pub(super) length: Option<f64>,
+    pub(super) density: Option<f64>,
+    pub(super) mass: Option<f64>,
+    pub(super) motion: Option<String>,
+    pub(super) force: Option<Vec<f64>>,
+    pub(super) restitution: Option<f64>,
+    pub(super) velocity: Option<Vec<f64>>,
+    pub(super) angular_velocity: Option<Vec<f64>>,
 }
 
 /// `[[probe]]` as written (docs/scene-format.md).

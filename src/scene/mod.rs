@@ -1,12 +1,14 @@
 //! Scene files: TOML in SI units, parsed with unknown keys rejected, then validated into a
 //! `Scene`. Every error names the file, the key and, where it can be found, the line.
 
+mod bodies;
 mod effects;
 mod file;
 mod probes;
 mod surface;
 mod validate;
 
+pub use bodies::{Body, BodyMass, BodyMotion, Shape};
 pub use effects::{Effects, LesSettings, ShiftingSettings};
 pub use probes::{Probe, ProbeField};
 pub use surface::{CubeRule, SurfaceKernel, SurfaceRequest, SurfaceSettings};
@@ -174,6 +176,8 @@ pub struct Scene {
     /// `[[probe]]`: points whose field is written to `probes.csv` every step (empty: none).
     pub probes: Vec<Probe>,
     pub walls: WallSettings,
+    /// `[[body]]`: rigid bodies in the fluid (empty: none).
+    pub bodies: Vec<Body>,
 }
 
 impl Scene {
@@ -219,7 +223,8 @@ impl Scene {
             .product();
         let fluid: f64 = scene.blocks.iter().map(|b| points(&b.region)).sum();
         let obstacles: f64 = scene.obstacles.iter().map(points).sum();
-        fluid.min(inside) + (with_walls - inside) + obstacles.min(inside)
+        let bodies: f64 = scene.bodies.iter().map(|b| points(&b.shape.bounds())).sum();
+        fluid.min(inside) + (with_walls - inside) + obstacles.min(inside) + bodies.min(inside)
     }
 
     /// Smoothing length h.
@@ -230,9 +235,12 @@ impl Scene {
     /// Whether the fluids differ in rest density: the scene has interfaces whose pairs are
     /// weighted (`interface`).
     pub fn has_interfaces(&self) -> bool {
-        self.fluids
-            .iter()
-            .any(|f| f.density != self.fluids[0].density)
+        let water = self.fluids[0].density;
+        self.fluids.iter().any(|f| f.density != water)
+            || self
+                .bodies
+                .iter()
+                .any(|b| b.mass != BodyMass::Density(water))
     }
 
     /// A hash of everything in the validated scene that shapes the trajectory: xxh3-64 of its

@@ -2,12 +2,13 @@
 //! key and, where it can be found, the line.
 
 use super::file::{
-    BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection,
-    ProbeSection, SceneFile, ShiftingSection, SurfaceSection,
+    BodySection, BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection,
+    ProbeSection, SceneFile, ShiftingSection, SimulationSection, SurfaceSection,
 };
 use super::{
-    Aabb, Block, CheckpointSettings, Effects, InitialVelocity, LesSettings, Probe, ProbeField,
-    Scene, SceneError, ShiftingSettings, SolverSettings, SurfaceRequest, SurfaceSettings,
+    Aabb, Block, Body, BodyMass, BodyMotion, CheckpointSettings, Effects, InitialVelocity,
+    LesSettings, Probe, ProbeField, Scene, SceneError, Shape, ShiftingSettings, SolverSettings,
+    SurfaceRequest, SurfaceSettings,
 };
 use crate::math::kernel::SUPPORT_IN_H;
 use std::path::Path;
@@ -267,6 +268,12 @@ impl Validator<'_> {
             .map(|s| self.surface(s))
             .transpose()?;
         let probes = self.probes(&f.probe, &container)?;
+        let bodies = self.bodies(&f.body, &container, &obstacles, s)?;
+        self.check(
+            bodies.is_empty() || !periodic.contains(&true),
+            "body",
+            "cannot be in a periodic container: a body crossing the period is not supported; close the container or remove the [[body]] sections",
+        )?;
 
         let name = match &s.name {
             Some(n) => {
@@ -310,6 +317,7 @@ impl Validator<'_> {
             walls: f.walls,
             surface,
             probes,
+            bodies,
         };
         self.fits_in_memory(&scene)?;
         Ok(scene)
@@ -601,6 +609,260 @@ impl Validator<'_> {
         Ok(probes)
     }
 
+    /// `[[body]]`: each a known shape with the keys it needs and no others, inside the
+    /// container, holding particles, clear of the obstacles and of the other bodies, with a
+    /// positive density or mass, a known motion.
+    fn bodies(
+        &self,
+        sections: &[BodySection],
+        container: &Aabb,
+        obstacles: &[Aabb],
+        s: &SimulationSection,
+    ) -> Result<Vec<Body>, SceneError> {
+        let dims = container.min.len();
+        let mut bodies: Vec<Body> = Vec::new();
+        for (k, b) in sections.iter().enumerate() {
+            let key = format!("body[{k}]");
+            let name = b.name.clone().unwrap_or_else(|| format!("body_{}", k + 1));
+            let plain = !name.is_empty()
+                && !name.contains(|c: char| {
+                    c == ',' || c == '"' || c.is_whitespace() || c.is_control()
+                });
+            self.check(
+                plain,
+                &format!("{key}.name"),
+                format!("= \"{name}\" must be a plain name for bodies.csv: not empty, no comma, quote or space"),
+            )?;
+            self.check(
+                bodies.iter().all(|o| o.name != name),
+                &format!("{key}.name"),
+                format!("= \"{name}\" is the name of an earlier [[body]]: give each body its own"),
+            )?;
+            let shape = self.shape(b, &key, dims, s.spacing)?;
+            let bounds = shape.bounds();
+            self.check(
+                bounds.within(container),
+                &format!("{key}.shape"),
+                format!(
+                    "the {} spans {:?} .. {:?}, which is not inside the container {:?} .. {:?}",
+                    shape.name(dims),
+                    bounds.min,
+                    bounds.max,
+                    container.min,
+                    container.max
+                ),
+            )?;
+            let lattice = lattice_points_in(&bounds, container, s.spacing);
+            self.check(
+                lattice.iter().any(|x| shape.contains(x)),
+                &format!("{key}.shape"),
+                format!(
+                    "the {} holds no lattice point of the spacing {:?} m: make it larger than a spacing",
+                    shape.name(dims),
+                    s.spacing
+                ),
+            )?;
+            if let Some(o) = obstacles.iter().position(|o| {
+                lattice
+                    .iter()
+                    .any(|x| shape.contains(x) && o.contains_within(x, 0.5 * s.spacing))
+            }) {
+                return Err(self.error(
+                    &format!("{key}.shape"),
+                    format!("the {} overlaps obstacle[{o}] at t = 0: bodies start clear of the obstacles", shape.name(dims)),
+                ));
+            }
+            if let Some(o) = bodies.iter().position(|o| {
+                lattice
+                    .iter()
+                    .any(|x| shape.contains(x) && o.shape.contains(x))
+            }) {
+                return Err(self.error(
+                    &format!("{key}.shape"),
+                    format!(
+                        "the {} overlaps body[{o}] (\"{}\") at t = 0: bodies start apart",
+                        shape.name(dims),
+                        bodies[o].name
+                    ),
+                ));
+            }
+            let mass = match (b.density, b.mass) {
+                (Some(density), None) => {
+                    self.positive(density, &format!("{key}.density"), "kg/m^3")?;
+                    BodyMass::Density(density)
+                }
+                (None, Some(mass)) => {
+                    self.positive(mass, &format!("{key}.mass"), "kg")?;
+                    BodyMass::Total(mass)
+                }
+                (Some(_), Some(_)) => {
+                    return Err(self.error(
+                        &format!("{key}.mass"),
+                        "and `density` are both given: give one of them",
+                    ))
+                }
+                (None, None) => {
+                    return Err(self.error(
+                        &key,
+                        "has neither `density` [kg/m^3] nor `mass` [kg]: give one of them",
+                    ))
+                }
+            };
+            let motion_name = b.motion.as_deref().unwrap_or("free");
+            let motion = BodyMotion::from_name(motion_name).ok_or_else(|| {
+                self.error(
+                    &format!("{key}.motion"),
+                    format!(
+                        "= \"{motion_name}\" is not a motion: one of {}",
+                        BodyMotion::NAMES.map(|n| format!("\"{n}\"")).join(", ")
+                    ),
+                )
+            })?;
+            let force = b.force.clone().unwrap_or(vec![0.0; dims]);
+            self.vector(&force, dims, &format!("{key}.force"))?;
+            let restitution = b.restitution.unwrap_or(0.0);
+            self.check(
+                (0.0..=1.0).contains(&restitution),
+                &format!("{key}.restitution"),
+                format!("= {restitution:?} must lie in [0, 1]"),
+            )?;
+            let velocity = b.velocity.clone().unwrap_or(vec![0.0; dims]);
+            self.vector(&velocity, dims, &format!("{key}.velocity"))?;
+            let turns = if dims == 2 { 1 } else { 3 };
+            let angular_velocity = b.angular_velocity.clone().unwrap_or(vec![0.0; turns]);
+            let spin_key = format!("{key}.angular_velocity");
+            self.check(
+                angular_velocity.len() == turns,
+                &spin_key,
+                format!(
+                    "has {} components; a {dims}D body takes {turns} (about z in 2D) [rad/s]",
+                    angular_velocity.len()
+                ),
+            )?;
+            self.vector(&angular_velocity, turns, &spin_key)?;
+            self.check(
+                motion == BodyMotion::Free
+                    || (velocity.iter().chain(&angular_velocity).all(|v| *v == 0.0)),
+                &format!("{key}.velocity"),
+                "and `angular_velocity` are for a free body: a fixed body starts at rest",
+            )?;
+            bodies.push(Body {
+                name,
+                shape,
+                mass,
+                motion,
+                force,
+                restitution,
+                velocity,
+                angular_velocity,
+            });
+        }
+        Ok(bodies)
+    }
+
+    /// The shape of `[[body]]` section `b`: its `shape` known in `dims` dimensions, the keys
+    /// it needs given and valid, the keys of other shapes absent.
+    fn shape(
+        &self,
+        b: &BodySection,
+        key: &str,
+        dims: usize,
+        spacing: f64,
+    ) -> Result<Shape, SceneError> {
+        let shapes: &[&str] = if dims == 2 {
+            &["box", "circle"]
+        } else {
+            &["box", "sphere", "cylinder"]
+        };
+        self.check(
+            shapes.contains(&b.shape.as_str()),
+            &format!("{key}.shape"),
+            format!(
+                "= \"{}\" is not a shape of a {dims}D scene: one of {}",
+                b.shape,
+                shapes
+                    .iter()
+                    .map(|n| format!("\"{n}\""))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )?;
+        let given = [
+            ("min", b.min.is_some()),
+            ("max", b.max.is_some()),
+            ("center", b.center.is_some()),
+            ("radius", b.radius.is_some()),
+            ("axis", b.axis.is_some()),
+            ("length", b.length.is_some()),
+        ];
+        let needs: &[&str] = match b.shape.as_str() {
+            "box" => &["min", "max"],
+            "cylinder" => &["center", "radius", "axis", "length"],
+            _ => &["center", "radius"],
+        };
+        for (name, present) in given {
+            let needed = needs.contains(&name);
+            self.check(
+                present == needed,
+                &format!("{key}.{name}"),
+                if needed {
+                    format!("is missing: a {} needs {}", b.shape, needs.join(", "))
+                } else {
+                    format!(
+                        "is not a key of a {}: it takes {}",
+                        b.shape,
+                        needs.join(", ")
+                    )
+                },
+            )?;
+        }
+        let vector = |v: &Option<Vec<f64>>, name: &str| -> Result<Vec<f64>, SceneError> {
+            let v = v.clone().unwrap_or_default();
+            self.vector(&v, dims, &format!("{key}.{name}"))?;
+            Ok(v)
+        };
+        let positive = |v: Option<f64>, name: &str| -> Result<f64, SceneError> {
+            let v = v.unwrap_or_default();
+            self.positive(v, &format!("{key}.{name}"), "m")?;
+            Ok(v)
+        };
+        Ok(match b.shape.as_str() {
+            "box" => {
+                let section = BoxSection {
+                    min: vector(&b.min, "min")?,
+                    max: vector(&b.max, "max")?,
+                };
+                let region = self.aabb(&section, dims, key, spacing)?;
+                Shape::Box {
+                    min: region.min,
+                    max: region.max,
+                }
+            }
+            "cylinder" => {
+                let axis_name = b.axis.as_deref().unwrap_or_default();
+                let axis = ["x", "y", "z"]
+                    .iter()
+                    .position(|a| *a == axis_name)
+                    .ok_or_else(|| {
+                        self.error(
+                            &format!("{key}.axis"),
+                            format!("= \"{axis_name}\" is not an axis: one of \"x\", \"y\", \"z\""),
+                        )
+                    })?;
+                Shape::Cylinder {
+                    center: vector(&b.center, "center")?,
+                    radius: positive(b.radius, "radius")?,
+                    axis,
+                    length: positive(b.length, "length")?,
+                }
+            }
+            _ => Shape::Ball {
+                center: vector(&b.center, "center")?,
+                radius: positive(b.radius, "radius")?,
+            },
+        })
+    }
+
     fn checkpoint(&self, c: &CheckpointSection) -> Result<CheckpointSettings, SceneError> {
         let default = CheckpointSettings::default();
         if let Some(interval) = c.interval {
@@ -620,6 +882,33 @@ impl Validator<'_> {
             keep: keep as usize,
         })
     }
+}
+
+/// The lattice points of the scene's particle lattice (`fill`: container.min + (k + ½) dx)
+/// inside `bounds`.
+fn lattice_points_in(bounds: &Aabb, container: &Aabb, spacing: f64) -> Vec<Vec<f64>> {
+    let dims = bounds.min.len();
+    let index = |d: usize, x: f64| ((x - container.min[d]) / spacing - 0.5).floor() as i64;
+    let lo: Vec<i64> = (0..dims).map(|d| index(d, bounds.min[d])).collect();
+    let hi: Vec<i64> = (0..dims).map(|d| index(d, bounds.max[d]) + 1).collect();
+    let mut points = Vec::new();
+    let mut k = lo.clone();
+    'walk: loop {
+        points.push(
+            (0..dims)
+                .map(|d| container.min[d] + (k[d] as f64 + 0.5) * spacing)
+                .collect(),
+        );
+        for d in 0..dims {
+            k[d] += 1;
+            if k[d] <= hi[d] {
+                continue 'walk;
+            }
+            k[d] = lo[d];
+        }
+        break;
+    }
+    points
 }
 
 /// 1-based line of a dotted key such as `fluid_block[1].fluid` in TOML source, if present.

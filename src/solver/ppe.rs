@@ -215,7 +215,7 @@ pub fn projection_source<const D: usize>(
 }
 
 /// Right-hand side b of the density correction's PPE rows: −α (ρ0 − ρ_i)/(Δt Δt_max) in the
-/// interior rows (`density_rate` = α/Δt_max; where the free surface truncates the kernel, only
+/// interior rows of fluid particles (zero in a rigid body's) (`density_rate` = α/Δt_max; where the free surface truncates the kernel, only
 /// compression counts: the summation density is low there because neighbours are missing),
 /// zero on the free surface, and no wall term: the correction's walls are mirror ghosts
 /// (∂P/∂n = 0), so their differences vanish. `closed` and `sealed` as in `projection_source`.
@@ -236,6 +236,8 @@ pub fn density_source<const D: usize>(
     let p = op.p;
     b.resize(op.roles.len(), 0.0);
     fill(b, |i| match op.roles[i] {
+        // A body does not compress: its summation density is not corrected.
+        Role::Interior if p.kind[i] == Kind::Body => 0.0,
         Role::Interior => {
             let deviation = p.rest_density[i] - p.density[i];
             let deviation = if full[i] {
@@ -336,7 +338,7 @@ fn divergence_source<const D: usize>(
     let velocity = |l: &Lanes<D>| -> [F64s; D] {
         match l.kind {
             Kind::Wall => ghost_velocity(p, l, u_star_i, u_i),
-            Kind::Fluid => std::array::from_fn(|d| l.load(&u_star[d])),
+            Kind::Fluid | Kind::Body => std::array::from_fn(|d| l.load(&u_star[d])),
         }
     };
     // ∇·u* = trace of the corrected velocity gradient, Eq. (22) with Eq. (24)–(25).
@@ -399,7 +401,7 @@ fn laplacian_correction<const D: usize>(
         let mass = volume_mass(p, interfaces.is_some(), &row, lanes);
         let cl = (scale * mass * laplacian_factor) & lanes.mask;
         let followed = match lanes.kind {
-            Kind::Fluid => lanes.rij,
+            Kind::Fluid | Kind::Body => lanes.rij,
             Kind::Wall => behind_walls(p, lanes, lanes.rij),
         };
         for d in 0..D {

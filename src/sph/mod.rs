@@ -73,7 +73,7 @@ pub fn viscous_acceleration<const D: usize>(
                 let nu = F64s::splat(nu_laminar);
                 (nu, nu, ghosts::no_slip_difference(p, l, u_i, d_i))
             }
-            Kind::Fluid => {
+            Kind::Fluid | Kind::Body => {
                 let nu_t = eddy.map_or(F64s::ZERO, |e| l.load(e));
                 let du = std::array::from_fn(|d| F64s::splat(u_i[d]) - l.load(&p.vel[d]));
                 (F64s::splat(nu_i), l.load(&p.viscosity) + nu_t, du)
@@ -128,7 +128,7 @@ pub fn velocity_gradient<const D: usize>(
 #[inline(always)]
 pub fn fluid_velocity<const D: usize>(p: &Particles<D>, u_i: [f64; D], l: &Lanes<D>) -> [F64s; D] {
     match l.kind {
-        Kind::Fluid => std::array::from_fn(|d| l.load(&p.vel[d])),
+        Kind::Fluid | Kind::Body => std::array::from_fn(|d| l.load(&p.vel[d])),
         Kind::Wall => ghost_velocity(p, l, u_i, u_i),
     }
 }
@@ -217,7 +217,7 @@ pub fn support_moments<const D: usize>(
         // The part of r_ij the pressure of j follows: all of it for fluid, the normal part for
         // a wall ghost.
         let followed = match l.kind {
-            Kind::Fluid => {
+            Kind::Fluid | Kind::Body => {
                 fluid_neighbours += l.count();
                 l.rij
             }

@@ -104,7 +104,7 @@ pub(super) fn pressure_gradient<const D: usize>(
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
     let own = F64s::splat(pressure[i]) - p_ref;
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
-        Kind::Fluid => side.across(p, interfaces, lanes, lanes.load(pressure) - p_ref),
+        Kind::Fluid | Kind::Body => side.across(p, interfaces, lanes, lanes.load(pressure) - p_ref),
         Kind::Wall => own + ghosts::ghost_pressure_difference(p, ghost_gravity, i, lanes),
     })
 }

@@ -20,7 +20,7 @@ use crate::boundary::faces::{self, Faces};
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_vector;
 use crate::neighbours::Neighbours;
-use crate::particles::{components, Particles};
+use crate::particles::{components, Kind, Particles};
 use crate::solver::ppe::Role;
 use crate::sph::interface;
 
@@ -62,7 +62,8 @@ impl<const D: usize> DensityCorrection<D> {
         // The correction's walls are mirror ghosts: no gravity in their differences.
         let mirror = [0.0; D];
         fill_vector(&mut self.displacement, |i| {
-            if surface.roles[i] == Role::Splash {
+            // Splashes stay in place; a body's particles move rigidly (`rigid_bodies`).
+            if surface.roles[i] == Role::Splash || p.kind[i] == Kind::Body {
                 return [0.0; D];
             }
             let grad = pressure_gradient(nb, p, density_pressure, surface, mirror, interfaces, i);

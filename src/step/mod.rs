@@ -7,12 +7,16 @@
 //!
 //! The fluid particles come first in the sorted order (`cell_list`), and every stage's array
 //! but the sort's holds the fluid particles only: the walls hold no unknown and need none.
+//! A rigid body's particles are sorted with the fluid and taken for fluid of the body's density
+//! up to the corrector; `rigid_bodies` then moves them rigidly (`bodies`).
 //! `Particles`, the lasting state, is written at named points only, each marked "Into the
 //! particles" in `advance`: the order of every array (the cell sort), the summation density
-//! (`density`), the pressures and PPE roles (`pressure_solve`), the new velocity (`corrector`),
+//! (`density`), the pressures and PPE roles (`pressure_solve`), the new velocity (`corrector`,
+//! the bodies' particles' from `rigid_bodies`),
 //! the walls' pressures on a frame (`wall_pressure`), the shifted velocity and pressure
 //! (`shifting`, over its own displacement plus the `density_correction`'s), the positions
-//! (`advection`, then wrapped into a periodic box). `Step` holds the
+//! (`advection`; the bodies' particles' from their poses, `rigid_bodies`; then wrapped into a
+//! periodic box). `Step` holds the
 //! scene's constants and the stages' scratch: it is built again from the scene on resume and
 //! never checkpointed.
 //!
@@ -32,11 +36,13 @@ mod interface_distance;
 mod kernel_correction;
 mod predictor;
 mod pressure_solve;
+mod rigid_bodies;
 mod shifting;
 pub mod time_step;
 pub mod timings;
 mod wall_pressure;
 
+use crate::bodies::Bodies;
 use crate::boundary::faces::Faces;
 use crate::boundary::ghosts;
 use crate::math::kernel::Quintic;
@@ -160,6 +166,7 @@ pub struct Step<const D: usize> {
     predictor: predictor::Predictor<D>,
     pressure_solve: pressure_solve::PressureSolve<D>,
     corrector: corrector::Corrector<D>,
+    rigid_bodies: Option<rigid_bodies::RigidBodies>,
     density_correction: Option<density_correction::DensityCorrection<D>>,
     wall_pressure: wall_pressure::WallPressure,
     shifting: Option<shifting::Shifting<D>>,
@@ -169,13 +176,15 @@ pub struct Step<const D: usize> {
 
 impl<const D: usize> Step<D> {
     /// The step of a scene with `settings`, on `grid`; `interfaces` is the kernel's table of
-    /// distances to an interface where the fluids differ in rest density (None: one density).
+    /// distances to an interface where the fluids differ in rest density (None: one density);
+    /// `bodies` whether the scene has rigid bodies.
     pub fn new(
         settings: StepSettings<D>,
         kernel: Quintic<D>,
         faces: Faces,
         grid: CellList<D>,
         interfaces: Option<Interfaces>,
+        bodies: bool,
     ) -> Self {
         let effects = &settings.effects;
         Self {
@@ -191,6 +200,7 @@ impl<const D: usize> Step<D> {
             predictor: predictor::Predictor::default(),
             pressure_solve: pressure_solve::PressureSolve::new(settings.alpha > 0.0),
             corrector: corrector::Corrector::default(),
+            rigid_bodies: bodies.then(rigid_bodies::RigidBodies::default),
             density_correction: (settings.alpha > 0.0)
                 .then(density_correction::DensityCorrection::default),
             wall_pressure: wall_pressure::WallPressure,
@@ -223,8 +233,11 @@ impl<const D: usize> Step<D> {
             &self.predictor as &dyn Stage<D>,
             &self.pressure_solve,
             &self.corrector,
-            &self.wall_pressure,
         ]);
+        if let Some(s) = &self.rigid_bodies {
+            stages.push(s);
+        }
+        stages.push(&self.wall_pressure);
         if let Some(s) = &self.density_correction {
             stages.push(s);
         }
@@ -260,10 +273,13 @@ impl<const D: usize> Step<D> {
     /// particles are dry, and visiting them at every step costs a large part of a step
     /// (docs/performance.md, "Walls no fluid touches").
     /// `probe`, if any, is handed the PPE's operator before the solve (`isph bench` times its
-    /// apply); the step goes on as without it.
+    /// apply); the step goes on as without it. `bodies` are the rigid bodies the particles of
+    /// kind `Body` belong to, advanced with them.
+    #[allow(clippy::too_many_arguments)]
     pub fn advance(
         &mut self,
         p: &mut Particles<D>,
+        bodies: &mut Bodies,
         time: f64,
         target: f64,
         timings: &mut Timings,
@@ -328,13 +344,17 @@ impl<const D: usize> Step<D> {
             fill(&mut p.pressure[..nf], |i| cavitation(clip, solved[i]));
             fill(&mut p.free_surface[..nf], |i| surface.roles[i].code());
             laps.lap(pressure_solve::NAME);
-            let velocity =
-                self.corrector
-                    .run(&nb, p, set, &self.faces, &surface, interfaces, u_star, dt);
-            // Into the particles: uⁿ⁺¹.
-            copy_vector(velocity, &mut p.vel);
+            self.corrector
+                .run(&nb, p, set, &self.faces, &surface, interfaces, u_star, dt);
             let grad_p = &*u_star;
             laps.lap(corrector::NAME);
+            let velocity = self.corrector.velocity_scratch();
+            if let Some(stage) = &mut self.rigid_bodies {
+                stage.run(&nb, p, bodies, set, velocity, dt);
+                laps.lap(rigid_bodies::NAME);
+            }
+            // Into the particles: uⁿ⁺¹ (the bodies' rigid).
+            copy_vector(velocity, &mut p.vel);
             let (density_error, disorder) =
                 diagnostics::full_support_statistics(&nb, p, surface.full_support);
             laps.part(diagnostics::NAME);
@@ -394,6 +414,13 @@ impl<const D: usize> Step<D> {
         let penetrations = self
             .advection
             .run(p, nf, dt, shift, &self.faces, set.spacing);
+        let penetrations = penetrations
+            + match &self.rigid_bodies {
+                // Into the particles: the bodies' particles' r, from their poses, and the
+                // fluid's put back off the bodies.
+                Some(stage) => stage.place(p, bodies, nf, set.spacing),
+                None => 0,
+            };
         laps.lap(advection::NAME);
         // Along a periodic axis a particle leaves the period only in the advection: wrapped
         // back here, the frames and checkpoints hold every position inside the box.

@@ -9,7 +9,7 @@ use crate::effects::shifting as fickian;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::{self, fill_vector};
 use crate::neighbours::{Lanes, Neighbours};
-use crate::particles::{components, Particles};
+use crate::particles::{components, Kind, Particles};
 use crate::scene::ShiftingSettings;
 use crate::solver::ppe::Role;
 use crate::sph::{self, Corrections};
@@ -59,6 +59,9 @@ impl<const D: usize> Shifting<D> {
         let (roles, full) = (surface.roles, surface.full_support);
         let touch = faces::touching_distance(set.spacing);
         fill_vector(&mut self.shift, |i| match roles[i] {
+            // A body's particles move rigidly (`rigid_bodies`): no shift, and no Taylor
+            // correction of their velocity.
+            _ if p.kind[i] == Kind::Body => [0.0; D],
             // Splashes are left in place: neither ∇C nor the Taylor correction means anything
             // there.
             Role::Interior | Role::Surface | Role::Reference => {

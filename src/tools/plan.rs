@@ -3,8 +3,8 @@
 //! counts come from the arrays themselves (`Simulation::arrays`, `Particles::arrays_mut`), so
 //! the plan and the step cannot disagree.
 
+use crate::scene::{BodyMotion, Effects, Scene};
 use crate::scene::{CubeRule, Probe, SurfaceSettings};
-use crate::scene::{Effects, Scene};
 use crate::simulation::{NoFluid, Simulation};
 use std::fmt;
 
@@ -37,6 +37,23 @@ pub struct Plan {
     /// Per-particle bytes of the particle state (position, velocity, …).
     pub state_bytes_per_particle: usize,
     pub stages: Vec<PlannedStage>,
+    /// `[[body]]`, each with its particles and the fluid lattice points it displaced.
+    pub bodies: Vec<PlannedBody>,
+}
+
+/// One rigid body as the plan lists it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedBody {
+    pub name: String,
+    pub motion: BodyMotion,
+    pub particles: usize,
+    /// Its mass [kg] (per metre of depth in 2D) and density [kg/m³].
+    pub mass: f64,
+    pub density: f64,
+    /// The diagonal of its inertia tensor about its centre of mass [kg m²] (2D: zz only).
+    pub inertia: [f64; 3],
+    /// Fluid lattice points it keeps clear of fluid at t = 0.
+    pub displaced: usize,
 }
 
 impl Plan {
@@ -68,6 +85,23 @@ impl Plan {
                     .sum(),
             })
             .collect();
+        let displaced = crate::fill::displaced_by_bodies::<D>(scene);
+        let volume = scene.spacing.powi(D as i32);
+        let bodies = sim
+            .bodies
+            .bodies
+            .iter()
+            .zip(displaced)
+            .map(|(b, displaced)| PlannedBody {
+                name: b.name.clone(),
+                motion: b.motion,
+                particles: b.offsets.len(),
+                mass: b.mass,
+                density: b.mass / (b.offsets.len() as f64 * volume),
+                inertia: std::array::from_fn(|d| b.inertia[d][d]),
+                displaced,
+            })
+            .collect();
         let state = sim.particles.arrays_mut();
         Ok(Plan {
             scene: scene.name.clone(),
@@ -81,6 +115,7 @@ impl Plan {
             probes: scene.probes.clone(),
             state_bytes_per_particle: state.iter().map(|(_, a)| a.element_bytes()).sum(),
             stages,
+            bodies,
         })
     }
 
@@ -150,10 +185,26 @@ impl fmt::Display for Plan {
         writeln!(f, "scene {} ({}D)", self.scene, self.dimensions)?;
         writeln!(
             f,
-            "particles: {} fluid + {} wall = {n}   (h = {:.4e} m, {} wall layers)",
+            "particles: {} fluid + {} wall and body = {n}   (h = {:.4e} m, {} wall layers)",
             self.fluid_particles, self.wall_particles, self.smoothing_length, self.wall_layers
         )?;
         writeln!(f, "effects: {}", effects_line(&self.effects))?;
+        for b in &self.bodies {
+            writeln!(
+                f,
+                "body {}: {} with {} particles, mass {:.4e} kg, density {:.1} kg/m³, inertia diag {} kg m²; displaces {} fluid lattice points",
+                b.name,
+                match b.motion {
+                    BodyMotion::Free => "free",
+                    BodyMotion::Fixed => "fixed",
+                },
+                b.particles,
+                b.mass,
+                b.density,
+                b.inertia.iter().map(|i| format!("{i:.3e}")).collect::<Vec<_>>().join(" "),
+                b.displaced
+            )?;
+        }
         writeln!(
             f,
             "      {:<25} {:>4} B/particle {:>9.2} MiB  position, velocity, wall normal, pressure, density, mass, ρ0, ν, kind, free surface, fluid, id",

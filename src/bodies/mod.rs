@@ -1,0 +1,450 @@
+//! Rigid bodies in the fluid, after Eq. (11)–(16): a body is a set of particles on the
+//! particle lattice inside its shape, treated as fluid of the body's density by every stage up
+//! to the corrector (so the pressure solve sees the body's inertia), then constrained to move
+//! rigidly. The constraint keeps the momentum and the angular momentum the corrector gave the
+//! body's particles: with m_i the particle masses, M = Σ m_i and r_ic the particle's offset from
+//! the centre of mass,
+//!
+//!   M (Vⁿ⁺¹ − Vⁿ) = Σ m_i (u_i − u_i^rigid) + Δt F_ext,     Eq. (14), as a momentum balance
+//!   Lⁿ⁺¹ − Lⁿ     = Σ m_i r_ic × (u_i − u_i^rigid),          Eq. (15), angular momentum
+//!   ωⁿ⁺¹ = R I⁻¹ Rᵀ Lⁿ⁺¹,  u_i = Vⁿ⁺¹ + ωⁿ⁺¹ × r_ic,          Eq. (16)
+//!
+//! with u_i the corrector's velocity of particle i and u_i^rigid its rigid velocity at the start
+//! of the step (docs/bodies.md, "The coupling"). The paper's scalar I_O of Eq. (13) is the
+//! polar moment, exact in 2D only; here I = Σ m_i (|r_ic|² 1 − r_ic ⊗ r_ic) in the body's own
+//! frame, turned into the world's by the orientation, a unit quaternion. Angular momentum, not
+//! an angle, is the integrated quantity, so a torque-free body keeps it to round-off. The state
+//! is f64 and lasting (checkpointed); the particles' positions are set from it every step,
+//! never advected, so a body never changes shape.
+
+use crate::math::aabb::Aabb;
+use crate::math::rotation::{self, cross, Mat3, Quaternion, Vec3};
+use crate::math::shape::Shape;
+use crate::particles::{Kind, Particles};
+use crate::scene::{BodyMotion, Scene};
+
+/// The lasting state of a rigid body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigidState {
+    /// Centre of mass [m].
+    pub centre: Vec3,
+    /// Rotation from the body's own frame (the world's at t = 0) to the world's.
+    pub orientation: Quaternion,
+    /// Velocity of the centre of mass [m/s].
+    pub velocity: Vec3,
+    /// Angular momentum about the centre of mass, world frame [kg m²/s].
+    pub angular_momentum: Vec3,
+    /// The fluid's force [N] and torque [N m] on the body over the last step (pressure,
+    /// viscosity and the walls' contact, without gravity and the external force).
+    pub force: Vec3,
+    pub torque: Vec3,
+}
+
+impl RigidState {
+    /// f64s of a state in a checkpoint.
+    pub const LEN: usize = 19;
+
+    pub fn to_array(&self) -> [f64; Self::LEN] {
+        let mut a = [0.0; Self::LEN];
+        let parts: [&[f64]; 6] = [
+            &self.centre,
+            &self.orientation.0,
+            &self.velocity,
+            &self.angular_momentum,
+            &self.force,
+            &self.torque,
+        ];
+        let mut k = 0;
+        for part in parts {
+            a[k..k + part.len()].copy_from_slice(part);
+            k += part.len();
+        }
+        a
+    }
+
+    pub fn from_array(a: &[f64]) -> Self {
+        let v = |k: usize| [a[k], a[k + 1], a[k + 2]];
+        Self {
+            centre: v(0),
+            orientation: Quaternion([a[3], a[4], a[5], a[6]]),
+            velocity: v(7),
+            angular_momentum: v(10),
+            force: v(13),
+            torque: v(16),
+        }
+    }
+}
+
+/// One rigid body: what the scene and its particles at t = 0 fix, and its state.
+#[derive(Clone, Debug)]
+pub struct RigidBody {
+    pub name: String,
+    /// The shape where the body starts (its frame then the world's).
+    pub shape: Shape,
+    /// The centre of mass at t = 0: the origin of the offsets in the shape's coordinates.
+    pub centre_at_start: Vec3,
+    /// The largest distance of the shape's surface from the centre of mass (a bound for the
+    /// contact's search).
+    pub reach: f64,
+    pub motion: BodyMotion,
+    /// M = Σ m_i [kg] (per metre of depth in 2D).
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass in the body's own frame [kg m²]; in 2D only
+    /// the zz part, the polar moment of Eq. (13).
+    pub inertia: Mat3,
+    pub external_force: Vec3,
+    pub restitution: f64,
+    /// The body's particles are those with ids first_id .. first_id + offsets.len().
+    pub first_id: u64,
+    /// Each particle's offset from the centre of mass in the body's own frame, by id − first_id.
+    pub offsets: Vec<Vec3>,
+    pub state: RigidState,
+}
+
+impl RigidBody {
+    /// The rotation matrix of the orientation.
+    pub fn rotation(&self) -> Mat3 {
+        self.state.orientation.matrix()
+    }
+
+    /// ω = R I⁻¹ Rᵀ L.
+    pub fn angular_velocity(&self) -> Vec3 {
+        let r = self.rotation();
+        let inverse = rotation::inverse_on_span(&self.inertia);
+        let body_l = rotation::apply_transposed(&r, self.state.angular_momentum);
+        rotation::apply(&r, rotation::apply(&inverse, body_l))
+    }
+
+    /// Offset of particle `id` from the centre, in the world frame, for rotation `r`.
+    pub fn arm(&self, r: &Mat3, id: u64) -> Vec3 {
+        rotation::apply(r, self.offsets[(id - self.first_id) as usize])
+    }
+
+    /// Kinetic energy ½ M V² + ½ ω·L [J].
+    pub fn kinetic_energy(&self) -> f64 {
+        let (v, w, l) = (
+            self.state.velocity,
+            self.angular_velocity(),
+            self.state.angular_momentum,
+        );
+        0.5 * self.mass * dot3(v, v) + 0.5 * dot3(w, l)
+    }
+}
+
+/// The bodies of a run, in the order of the scene's `[[body]]` sections, and what their contact
+/// with the container needs.
+#[derive(Clone, Debug)]
+pub struct Bodies {
+    pub bodies: Vec<RigidBody>,
+    /// The container's faces a body's particles keep half a spacing off, per axis (None along
+    /// a periodic axis).
+    faces: Vec<Option<(f64, f64)>>,
+    spacing: f64,
+}
+
+impl Bodies {
+    /// The bodies of `scene` from their particles at t = 0 (`fill::build`): body particle i
+    /// has kind `Body` and body index `fluid[i]`, and its index is its id.
+    pub fn new<const D: usize>(scene: &Scene, p: &Particles<D>) -> Self {
+        let bodies = scene
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| {
+                let members: Vec<usize> = (0..p.len())
+                    .filter(|&i| p.kind[i] == Kind::Body && p.fluid[i] as usize == b)
+                    .collect();
+                let at = |i: usize| -> Vec3 {
+                    std::array::from_fn(|d| if d < D { p.pos[d][i] } else { 0.0 })
+                };
+                let mass: f64 = members.iter().map(|&i| p.mass[i]).sum();
+                let moment: Vec3 = members.iter().fold([0.0; 3], |s, &i| {
+                    let x = at(i);
+                    std::array::from_fn(|d| s[d] + p.mass[i] * x[d])
+                });
+                let centre = moment.map(|m| m / mass);
+                let offsets: Vec<Vec3> = members
+                    .iter()
+                    .map(|&i| {
+                        let x = at(i);
+                        std::array::from_fn(|d| x[d] - centre[d])
+                    })
+                    .collect();
+                let masses: Vec<f64> = members.iter().map(|&i| p.mass[i]).collect();
+                let inertia = inertia_tensor(&offsets, &masses, D);
+                let spin: Vec3 = match body.angular_velocity[..] {
+                    [wz] => [0.0, 0.0, wz],
+                    ref w => std::array::from_fn(|d| w[d]),
+                };
+                let first_id = p.id[members[0]];
+                debug_assert!(members
+                    .iter()
+                    .enumerate()
+                    .all(|(k, &i)| p.id[i] == first_id + k as u64));
+                let bounds = body.shape.bounds();
+                let reach = (0..D)
+                    .map(|d| {
+                        let far = (bounds.min[d] - centre[d])
+                            .abs()
+                            .max((bounds.max[d] - centre[d]).abs());
+                        far * far
+                    })
+                    .sum::<f64>()
+                    .sqrt();
+                RigidBody {
+                    name: body.name.clone(),
+                    shape: body.shape.clone(),
+                    centre_at_start: centre,
+                    reach,
+                    motion: body.motion,
+                    mass,
+                    inertia,
+                    external_force: std::array::from_fn(|d| {
+                        body.force.get(d).copied().unwrap_or(0.0)
+                    }),
+                    restitution: body.restitution,
+                    first_id,
+                    offsets,
+                    state: RigidState {
+                        centre,
+                        orientation: Quaternion::IDENTITY,
+                        velocity: std::array::from_fn(|d| {
+                            body.velocity.get(d).copied().unwrap_or(0.0)
+                        }),
+                        // L = I ω: at t = 0 the body's frame is the world's.
+                        angular_momentum: rotation::apply(&inertia, spin),
+                        force: [0.0; 3],
+                        torque: [0.0; 3],
+                    },
+                }
+            })
+            .collect();
+        let c: &Aabb = &scene.container;
+        Self {
+            bodies,
+            faces: (0..D)
+                .map(|d| (!scene.periodic[d]).then_some((c.min[d], c.max[d])))
+                .collect(),
+            spacing: scene.spacing,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bodies.is_empty()
+    }
+
+    /// Gives the bodies' particles their bodies' rigid velocities (at t = 0).
+    pub fn set_particle_velocities<const D: usize>(&self, p: &mut Particles<D>) {
+        for body in &self.bodies {
+            let (r, w) = (body.rotation(), body.angular_velocity());
+            for i in (0..p.len()).filter(|&i| p.kind[i] == Kind::Body) {
+                if !(body.first_id..body.first_id + body.offsets.len() as u64).contains(&p.id[i]) {
+                    continue;
+                }
+                let u = rigid_velocity(body.state.velocity, w, body.arm(&r, p.id[i]));
+                for d in 0..D {
+                    p.vel[d][i] = u[d];
+                }
+            }
+        }
+    }
+
+    /// The states of every body, one after the other (a checkpoint's `bodies` array).
+    pub fn states(&self) -> Vec<f64> {
+        self.bodies
+            .iter()
+            .flat_map(|b| b.state.to_array())
+            .collect()
+    }
+
+    /// Restores the states written by `states`; false if `states` does not hold one per body.
+    pub fn restore(&mut self, states: &[f64]) -> bool {
+        if states.len() != self.bodies.len() * RigidState::LEN {
+            return false;
+        }
+        for (body, s) in self.bodies.iter_mut().zip(states.chunks(RigidState::LEN)) {
+            body.state = RigidState::from_array(s);
+        }
+        true
+    }
+
+    /// Advances body b's state over `dt` from the momentum `impulse` and angular momentum
+    /// `angular_impulse` the step's fluid stages gave its particles beyond their rigid motion
+    /// (gravity included), then keeps it off the container's faces (`keep_inside`).
+    pub fn advance(
+        &mut self,
+        b: usize,
+        impulse: Vec3,
+        angular_impulse: Vec3,
+        gravity: Vec3,
+        dt: f64,
+    ) {
+        let faces = self.faces.clone();
+        let spacing = self.spacing;
+        let body = &mut self.bodies[b];
+        let s = body.state;
+        let (force, torque) = (
+            std::array::from_fn(|d| impulse[d] / dt - body.mass * gravity[d]),
+            angular_impulse.map(|t| t / dt),
+        );
+        match body.motion {
+            BodyMotion::Fixed => {
+                body.state.force = force;
+                body.state.torque = torque;
+            }
+            BodyMotion::Free => {
+                // Eq. (14): the momentum balance; the trapezoid for the centre is exact under a
+                // constant force (free fall).
+                let velocity: Vec3 = std::array::from_fn(|d| {
+                    s.velocity[d] + (impulse[d] + dt * body.external_force[d]) / body.mass
+                });
+                let centre =
+                    std::array::from_fn(|d| s.centre[d] + 0.5 * dt * (s.velocity[d] + velocity[d]));
+                let angular_momentum =
+                    std::array::from_fn(|d| s.angular_momentum[d] + angular_impulse[d]);
+                body.state = RigidState {
+                    velocity,
+                    angular_momentum,
+                    force,
+                    torque,
+                    ..s
+                };
+                // Eq. (15)–(16): turn by ωⁿ⁺¹ Δt.
+                let w = body.angular_velocity();
+                body.state.orientation = Quaternion::from_rotation_vector(w.map(|w| w * dt))
+                    .then_after(s.orientation)
+                    .normalised();
+                body.state.centre = centre;
+                keep_inside(body, &faces, spacing);
+            }
+        }
+    }
+}
+
+impl Bodies {
+    /// The hard contact of a fluid particle at x with velocity u with the bodies, as
+    /// `Faces::contact` with the walls: a particle closer than `gap` to a body's surface (or
+    /// inside it) is put back `gap` off it along the surface's normal, and keeps no velocity
+    /// into the body relative to the body's surface. Returns whether it moved, and whether it
+    /// had crossed the surface (a penetration).
+    pub fn keep_out(&self, x: &mut Vec3, u: &mut Vec3, gap: f64, dims: usize) -> (bool, bool) {
+        let (mut moved, mut crossed) = (false, false);
+        for body in &self.bodies {
+            let s = &body.state;
+            let arm: Vec3 = std::array::from_fn(|d| x[d] - s.centre[d]);
+            if arm.iter().map(|a| a * a).sum::<f64>() > (body.reach + gap).powi(2) {
+                continue;
+            }
+            let r = body.rotation();
+            let local = rotation::apply_transposed(&r, arm);
+            let at_start = |l: Vec3| -> Vec<f64> {
+                (0..dims).map(|d| body.centre_at_start[d] + l[d]).collect()
+            };
+            let distance = body.shape.signed_distance(&at_start(local));
+            if distance >= gap {
+                continue;
+            }
+            // The outward normal: the gradient of the signed distance, by central differences.
+            let eps = 1e-3 * gap;
+            let gradient: Vec3 = std::array::from_fn(|d| {
+                if d >= dims {
+                    return 0.0;
+                }
+                let (mut plus, mut minus) = (local, local);
+                plus[d] += eps;
+                minus[d] -= eps;
+                (body.shape.signed_distance(&at_start(plus))
+                    - body.shape.signed_distance(&at_start(minus)))
+                    / (2.0 * eps)
+            });
+            let length = dot3(gradient, gradient).sqrt();
+            if length == 0.0 {
+                continue;
+            }
+            let normal = rotation::apply(&r, gradient.map(|g| g / length));
+            for d in 0..dims {
+                x[d] += (gap - distance) * normal[d];
+            }
+            let surface = rigid_velocity(
+                s.velocity,
+                body.angular_velocity(),
+                std::array::from_fn(|d| x[d] - s.centre[d]),
+            );
+            let into: f64 = (0..dims).map(|d| (u[d] - surface[d]) * normal[d]).sum();
+            if into < 0.0 {
+                for d in 0..dims {
+                    u[d] -= into * normal[d];
+                }
+            }
+            moved = true;
+            crossed = crossed || distance < 0.0;
+        }
+        (moved, crossed)
+    }
+}
+
+/// The contact of a body with the container: each of its particles stays half a spacing
+/// inside every face (where the lattice puts the first fluid and body particles at t = 0). A
+/// body that would cross a face is moved back along its normal by its deepest particle's
+/// penetration, and its velocity into the face becomes −e times itself (e the restitution).
+/// The wall ghosts' pressure holds a body off a face as it does the fluid; this catches what
+/// comes through, deterministically, as `Faces::contact` does for fluid particles.
+fn keep_inside(body: &mut RigidBody, faces: &[Option<(f64, f64)>], spacing: f64) {
+    let r = body.rotation();
+    let arms: Vec<Vec3> = body
+        .offsets
+        .iter()
+        .map(|o| rotation::apply(&r, *o))
+        .collect();
+    let gap = 0.5 * spacing;
+    for (d, face) in faces.iter().enumerate() {
+        let Some((lo, hi)) = *face else { continue };
+        let lowest = arms.iter().map(|a| a[d]).fold(f64::INFINITY, f64::min);
+        let highest = arms.iter().map(|a| a[d]).fold(f64::NEG_INFINITY, f64::max);
+        let s = &mut body.state;
+        let below = lo + gap - (s.centre[d] + lowest);
+        let above = s.centre[d] + highest - (hi - gap);
+        if below > 0.0 {
+            s.centre[d] += below;
+            if s.velocity[d] < 0.0 {
+                s.velocity[d] *= -body.restitution;
+            }
+        } else if above > 0.0 {
+            s.centre[d] -= above;
+            if s.velocity[d] > 0.0 {
+                s.velocity[d] *= -body.restitution;
+            }
+        }
+    }
+}
+
+/// I = Σ m (|r|² 1 − r ⊗ r) of point masses `masses` at `offsets` from the centre; in 2D only
+/// I_zz = Σ m |r|² (a 2D body turns about z only).
+fn inertia_tensor(offsets: &[Vec3], masses: &[f64], dims: usize) -> Mat3 {
+    let mut inertia = [[0.0; 3]; 3];
+    for (r, m) in offsets.iter().zip(masses) {
+        let r2 = dot3(*r, *r);
+        for a in 0..3 {
+            for b in 0..3 {
+                let delta = if a == b { r2 } else { 0.0 };
+                inertia[a][b] += m * (delta - r[a] * r[b]);
+            }
+        }
+    }
+    if dims == 2 {
+        let zz = inertia[2][2];
+        inertia = [[0.0; 3]; 3];
+        inertia[2][2] = zz;
+    }
+    inertia
+}
+
+/// The rigid velocity V + ω × r of a point at arm r.
+pub fn rigid_velocity(velocity: Vec3, omega: Vec3, arm: Vec3) -> Vec3 {
+    let w = cross(omega, arm);
+    std::array::from_fn(|d| velocity[d] + w[d])
+}
+
+fn dot3(a: Vec3, b: Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}

@@ -1,0 +1,104 @@
+//! The shapes of rigid bodies, as signed distance functions: negative inside, zero on the
+//! surface, the distance to it outside. The inside test fills a body's particles; the distance
+//! outside keeps fluid half a spacing off it at the start.
+
+use super::aabb::Aabb;
+
+/// A body's shape where it starts, in world coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// An axis-aligned box [min, max].
+    Box { min: Vec<f64>, max: Vec<f64> },
+    /// A circle (2D) or a sphere (3D).
+    Ball { center: Vec<f64>, radius: f64 },
+    /// A 3D cylinder along coordinate axis `axis` (0 x, 1 y, 2 z), `length` long, centred on
+    /// `center`.
+    Cylinder {
+        center: Vec<f64>,
+        radius: f64,
+        axis: usize,
+        length: f64,
+    },
+}
+
+impl Shape {
+    /// The shape's name in a scene (`shape = "…"`), in `dims` dimensions.
+    pub fn name(&self, dims: usize) -> &'static str {
+        match self {
+            Shape::Box { .. } => "box",
+            Shape::Ball { .. } if dims == 2 => "circle",
+            Shape::Ball { .. } => "sphere",
+            Shape::Cylinder { .. } => "cylinder",
+        }
+    }
+
+    /// Signed distance from x to the surface: negative inside.
+    pub fn signed_distance(&self, x: &[f64]) -> f64 {
+        match self {
+            Shape::Box { min, max } => {
+                let q: Vec<f64> = (0..x.len())
+                    .map(|d| (x[d] - 0.5 * (min[d] + max[d])).abs() - 0.5 * (max[d] - min[d]))
+                    .collect();
+                let outside = q.iter().map(|q| q.max(0.0).powi(2)).sum::<f64>().sqrt();
+                let inside = q.iter().copied().fold(f64::NEG_INFINITY, f64::max).min(0.0);
+                outside + inside
+            }
+            Shape::Ball { center, radius } => distance(x, center) - radius,
+            Shape::Cylinder {
+                center,
+                radius,
+                axis,
+                length,
+            } => {
+                let radial = (0..x.len())
+                    .filter(|d| d != axis)
+                    .map(|d| (x[d] - center[d]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+                    - radius;
+                let along = (x[*axis] - center[*axis]).abs() - 0.5 * length;
+                let outside = (radial.max(0.0).powi(2) + along.max(0.0).powi(2)).sqrt();
+                outside + radial.max(along).min(0.0)
+            }
+        }
+    }
+
+    /// Whether x lies inside.
+    pub fn contains(&self, x: &[f64]) -> bool {
+        self.signed_distance(x) < 0.0
+    }
+
+    /// The smallest axis-aligned box around the shape.
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            Shape::Box { min, max } => Aabb {
+                min: min.clone(),
+                max: max.clone(),
+            },
+            Shape::Ball { center, radius } => Aabb {
+                min: center.iter().map(|c| c - radius).collect(),
+                max: center.iter().map(|c| c + radius).collect(),
+            },
+            Shape::Cylinder {
+                center,
+                radius,
+                axis,
+                length,
+            } => {
+                let half = |d: usize| if d == *axis { 0.5 * length } else { *radius };
+                Aabb {
+                    min: (0..center.len()).map(|d| center[d] - half(d)).collect(),
+                    max: (0..center.len()).map(|d| center[d] + half(d)).collect(),
+                }
+            }
+        }
+    }
+}
+
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}

@@ -1,0 +1,152 @@
+//! The rigid bodies' constraint, Eq. (11)–(16) (`bodies`): after the corrector, each body's
+//! particles' momentum and angular momentum beyond their rigid motion advance the body, and
+//! their velocities become its rigid velocities; after the advection, their positions are set
+//! from its pose. Runs only in a scene with bodies.
+
+use super::{Stage, StepSettings};
+use crate::bodies::{rigid_velocity, Bodies};
+use crate::math::memory::ArraySize;
+use crate::math::rotation::{cross, Vec3};
+use crate::neighbours::Neighbours;
+use crate::particles::{Kind, Particles};
+
+pub const NAME: &str = "rigid bodies";
+
+#[derive(Default)]
+pub struct RigidBodies {
+    /// The body particles' indices in the sorted order, found each step.
+    members: Vec<u32>,
+}
+
+impl RigidBodies {
+    /// Advances `bodies` over `dt` from `velocity`, the corrector's uⁿ⁺¹ of the `nf` fluid and
+    /// body particles, and puts their rigid velocities there. The sums run over the particles
+    /// in the sorted order, one thread: the same bits whatever the thread count.
+    pub fn run<const D: usize>(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        bodies: &mut Bodies,
+        set: &StepSettings<D>,
+        velocity: &mut [Vec<f64>; D],
+        dt: f64,
+    ) {
+        let nf = velocity[0].len();
+        self.members.clear();
+        self.members
+            .extend((0..nf as u32).filter(|&i| p.kind[i as usize] == Kind::Body));
+        let count = bodies.bodies.len();
+        let (mut impulse, mut angular) = (vec![[0.0; 3]; count], vec![[0.0; 3]; count]);
+        let mut touched = vec![false; count];
+        let rigid_now: Vec<_> = bodies
+            .bodies
+            .iter()
+            .map(|b| (b.state.velocity, b.angular_velocity(), b.state.centre))
+            .collect();
+        for &i in &self.members {
+            let i = i as usize;
+            let b = p.fluid[i] as usize;
+            let (v, w, centre) = rigid_now[b];
+            let arm: Vec3 =
+                std::array::from_fn(|d| if d < D { p.pos[d][i] - centre[d] } else { 0.0 });
+            let rigid = rigid_velocity(v, w, arm);
+            let du: Vec3 = std::array::from_fn(|d| {
+                if d < D {
+                    p.mass[i] * (velocity[d][i] - rigid[d])
+                } else {
+                    0.0
+                }
+            });
+            let t = cross(arm, du);
+            for d in 0..3 {
+                impulse[b][d] += du[d];
+                angular[b][d] += t[d];
+            }
+            touched[b] = touched[b] || touches_another(nb, p, i);
+        }
+        let gravity: Vec3 = std::array::from_fn(|d| if d < D { set.gravity[d] } else { 0.0 });
+        for b in 0..count {
+            if !touched[b] {
+                // Nothing but the body in reach of its particles: in the air it feels gravity
+                // alone, whatever the pressure solve left inside it (its rows are solved to the
+                // tolerance only); free fall is then exact to round-off.
+                let mass = bodies.bodies[b].mass;
+                impulse[b] = gravity.map(|g| mass * g * dt);
+                angular[b] = [0.0; 3];
+            }
+            bodies.advance(b, impulse[b], angular[b], gravity, dt);
+        }
+        let poses: Vec<_> = bodies
+            .bodies
+            .iter()
+            .map(|b| (b.rotation(), b.state.velocity, b.angular_velocity()))
+            .collect();
+        for &i in &self.members {
+            let i = i as usize;
+            let body = &bodies.bodies[p.fluid[i] as usize];
+            let (r, v, w) = &poses[p.fluid[i] as usize];
+            let u = rigid_velocity(*v, *w, body.arm(r, p.id[i]));
+            for d in 0..D {
+                velocity[d][i] = u[d];
+            }
+        }
+    }
+
+    /// Puts the body particles where their bodies' poses put them, then the `nf` fluid
+    /// particles that came within a quarter spacing of a body back off it (`Bodies::keep_out`);
+    /// returns how many had crossed a body's surface.
+    pub fn place<const D: usize>(
+        &self,
+        p: &mut Particles<D>,
+        bodies: &Bodies,
+        nf: usize,
+        spacing: f64,
+    ) -> usize {
+        let rotations: Vec<_> = bodies.bodies.iter().map(|b| b.rotation()).collect();
+        for &i in &self.members {
+            let i = i as usize;
+            let b = p.fluid[i] as usize;
+            let body = &bodies.bodies[b];
+            let arm = body.arm(&rotations[b], p.id[i]);
+            for d in 0..D {
+                p.pos[d][i] = body.state.centre[d] + arm[d];
+            }
+        }
+        let mut crossings = 0;
+        for i in (0..nf).filter(|&i| p.kind[i] == Kind::Fluid) {
+            let mut x = std::array::from_fn(|d| if d < D { p.pos[d][i] } else { 0.0 });
+            let mut u = std::array::from_fn(|d| if d < D { p.vel[d][i] } else { 0.0 });
+            let (moved, crossed) = bodies.keep_out(&mut x, &mut u, 0.25 * spacing, D);
+            crossings += crossed as usize;
+            if moved {
+                for d in 0..D {
+                    (p.pos[d][i], p.vel[d][i]) = (x[d], u[d]);
+                }
+            }
+        }
+        crossings
+    }
+}
+
+/// Whether a particle of another body, of the fluid or of a wall is in reach of body particle i.
+fn touches_another<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> bool {
+    let mut touches = false;
+    nb.for_each(i, |j, _, _| {
+        touches = touches || p.kind[j] != Kind::Body || p.fluid[j] != p.fluid[i];
+    });
+    touches
+}
+
+impl<const D: usize> Stage<D> for RigidBodies {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn describe(&self, _: &StepSettings<D>) -> String {
+        "Eq. (11)–(16): each body's momentum and angular momentum from its particles' corrected velocities; V, L, the centre (trapezoid) and the orientation quaternion advanced in f64; contact with the container's faces; the particles' velocities and positions set rigidly".into()
+    }
+
+    fn arrays(&self) -> Vec<ArraySize> {
+        vec![ArraySize::sparse("body particles", &self.members)]
+    }
+}
