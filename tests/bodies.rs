@@ -272,7 +272,7 @@ density = 1500.0
         "t = {t}: still sinking at {} m/s",
         last[VY]
     );
-    // No fluid particle ever inside the body, nor closer than a quarter spacing to its surface.
+    // No fluid particle ever inside the body.
     for frame in 0..rows.len() {
         let centre = [rows[frame].1[0], rows[frame].1[Y]];
         let kind: Vec<i32> = read_frame(dir.path(), frame, "kind");
@@ -301,7 +301,7 @@ density = 1000.0
     let rows = rows(dir.path(), 0);
     // The still water around it stirs at up to ~1e-3 m/s while its pressure builds up; the
     // body moves with it and no faster (measured 1.7e-3 m/s at most, against the 1e-3 √(gD)
-    // = 0.99e-3 m/s asked: docs/bodies.md, "A neutral body").
+    // = 0.99e-3 m/s asked: docs/bodies.md, "Measured").
     let water = stats_column(dir.path(), "max_speed")
         .into_iter()
         .fold(0.0, f64::max);

@@ -235,16 +235,12 @@ impl Bodies {
 
     /// Gives the bodies' particles their bodies' rigid velocities (at t = 0).
     pub fn set_particle_velocities<const D: usize>(&self, p: &mut Particles<D>) {
-        for body in &self.bodies {
-            let (r, w) = (body.rotation(), body.angular_velocity());
-            for i in (0..p.len()).filter(|&i| p.kind[i] == Kind::Body) {
-                if !(body.first_id..body.first_id + body.offsets.len() as u64).contains(&p.id[i]) {
-                    continue;
-                }
-                let u = rigid_velocity(body.state.velocity, w, body.arm(&r, p.id[i]));
-                for d in 0..D {
-                    p.vel[d][i] = u[d];
-                }
+        for i in (0..p.len()).filter(|&i| p.kind[i] == Kind::Body) {
+            let body = &self.bodies[p.fluid[i] as usize];
+            let arm = body.arm(&body.rotation(), p.id[i]);
+            let u = rigid_velocity(body.state.velocity, body.angular_velocity(), arm);
+            for d in 0..D {
+                p.vel[d][i] = u[d];
             }
         }
     }
@@ -279,8 +275,7 @@ impl Bodies {
         gravity: Vec3,
         dt: f64,
     ) {
-        let faces = self.faces.clone();
-        let spacing = self.spacing;
+        let (faces, spacing) = (&self.faces, self.spacing);
         let body = &mut self.bodies[b];
         let s = body.state;
         let (force, torque) = (
@@ -315,7 +310,7 @@ impl Bodies {
                     .then_after(s.orientation)
                     .normalised();
                 body.state.centre = centre;
-                keep_inside(body, &faces, spacing);
+                keep_inside(body, faces, spacing);
             }
         }
     }

@@ -4,7 +4,7 @@
 //! step (pressure, viscosity and wall contact; not gravity nor the body's external force). In
 //! 2D z, qx, qy, wx, wy, fz, tx and ty are zero.
 
-use super::csv::CsvWriter;
+use super::csv::{end_of_row, CsvWriter, CutAt};
 use super::OutputError;
 use crate::bodies::Bodies;
 use std::path::Path;
@@ -61,33 +61,12 @@ impl BodiesWriter {
 /// Length in bytes of the bodies.csv of `dir` up to the rows of its first `frames` frames of
 /// `bodies` bodies each. Refuses a file with another header or fewer rows.
 pub fn end_of_frames(dir: &Path, frames: usize, bodies: usize) -> Result<u64, OutputError> {
-    let path = dir.join(FILE_NAME);
-    let text = std::fs::read(&path).map_err(|source| OutputError::Read {
-        path: path.clone(),
-        source,
-    })?;
-    let mismatch = |what: String| OutputError::Mismatch {
-        path: path.clone(),
-        what,
+    let what = format!("the checkpoint's {frames} frames of {bodies} bodies");
+    let at = CutAt::Rows {
+        count: frames * bodies,
+        what: &what,
     };
-    // A row cut short by a kill can only be the last line: only complete lines count.
-    let lines: Vec<&[u8]> = text
-        .split_inclusive(|&b| b == b'\n')
-        .filter(|l| l.ends_with(b"\n"))
-        .collect();
-    if lines.first().copied() != Some(format!("{HEADER}\n").as_bytes()) {
-        return Err(mismatch(format!(
-            "its first line is not the header `{HEADER}`"
-        )));
-    }
-    let rows = frames * bodies;
-    if lines.len() < 1 + rows {
-        return Err(mismatch(format!(
-            "it holds {} rows, fewer than the {rows} of the checkpoint's {frames} frames of {bodies} bodies",
-            lines.len() - 1
-        )));
-    }
-    Ok(lines[..1 + rows].iter().map(|l| l.len() as u64).sum())
+    end_of_row(&dir.join(FILE_NAME), HEADER, at)
 }
 
 /// The bodies.csv of `dir`: its rows as (time, body, numbers x … tz).

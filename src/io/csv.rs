@@ -74,13 +74,18 @@ impl CsvWriter {
 }
 
 /// Where a run's CSV file is cut back to on resume: after the header (a checkpoint before the
-/// first step), or after the row whose first field is `first_field`.
+/// first step), after the row whose first field is `first_field`, or after the first `count`
+/// rows (bodies.csv: the rows of the frames a checkpoint counts).
 #[derive(Clone, Copy, Debug)]
 pub enum CutAt<'a> {
     Header,
     Row {
         first_field: &'a str,
         /// The row as a message names it ("the checkpoint's step 120").
+        what: &'a str,
+    },
+    Rows {
+        count: usize,
         what: &'a str,
     },
 }
@@ -108,8 +113,19 @@ pub fn end_of_row(path: &Path, header: &str, at: CutAt) -> Result<u64, OutputErr
         )));
     }
     let mut end = first.len() as u64;
-    let CutAt::Row { first_field, what } = at else {
-        return Ok(end);
+    let (first_field, what) = match at {
+        CutAt::Header => return Ok(end),
+        CutAt::Rows { count, what } => {
+            let rows: Vec<&[u8]> = lines.take(count).collect();
+            if rows.len() < count {
+                return Err(mismatch(format!(
+                    "it holds {} complete rows, fewer than the {count} of {what}",
+                    rows.len()
+                )));
+            }
+            return Ok(end + rows.iter().map(|l| l.len() as u64).sum::<u64>());
+        }
+        CutAt::Row { first_field, what } => (first_field, what),
     };
     let mut last = String::new();
     for line in lines {

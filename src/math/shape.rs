@@ -39,9 +39,7 @@ impl Shape {
                 let q: Vec<f64> = (0..x.len())
                     .map(|d| (x[d] - 0.5 * (min[d] + max[d])).abs() - 0.5 * (max[d] - min[d]))
                     .collect();
-                let outside = q.iter().map(|q| q.max(0.0).powi(2)).sum::<f64>().sqrt();
-                let inside = q.iter().copied().fold(f64::NEG_INFINITY, f64::max).min(0.0);
-                outside + inside
+                slab_distance(&q)
             }
             Shape::Ball { center, radius } => distance(x, center) - radius,
             Shape::Cylinder {
@@ -57,8 +55,7 @@ impl Shape {
                     .sqrt()
                     - radius;
                 let along = (x[*axis] - center[*axis]).abs() - 0.5 * length;
-                let outside = (radial.max(0.0).powi(2) + along.max(0.0).powi(2)).sqrt();
-                outside + radial.max(along).min(0.0)
+                slab_distance(&[radial, along])
             }
         }
     }
@@ -93,6 +90,15 @@ impl Shape {
             }
         }
     }
+}
+
+/// The signed distance to the intersection of slabs, from the signed distances `q` to each
+/// (negative inside): the Euclidean distance over the slabs outside, the nearest face inside.
+/// A box is the slabs of its axes; a cylinder its radial and axial slabs.
+fn slab_distance(q: &[f64]) -> f64 {
+    let outside = q.iter().map(|q| q.max(0.0).powi(2)).sum::<f64>().sqrt();
+    let inside = q.iter().copied().fold(f64::NEG_INFINITY, f64::max).min(0.0);
+    outside + inside
 }
 
 fn distance(a: &[f64], b: &[f64]) -> f64 {
