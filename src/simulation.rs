@@ -3,6 +3,7 @@
 
 use crate::bodies::Bodies;
 use crate::boundary::faces::Faces;
+use crate::boundary::moving_frame::MovingFrame;
 use crate::fill;
 use crate::io::stats::StepStats;
 use crate::math::kernel::{Quintic, SUPPORT_IN_H};
@@ -119,6 +120,13 @@ impl<const D: usize> Simulation<D> {
             CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
             interfaces,
             !bodies.is_empty(),
+            scene
+                .container_motion
+                .clone()
+                .map(|trajectory| MovingFrame {
+                    trajectory,
+                    gravity: std::array::from_fn(|d| scene.gravity.get(d).copied().unwrap_or(0.0)),
+                }),
         );
         let timings = Timings::new(stepper.stages().iter().map(|s| s.name()));
         let c = &scene.container;

@@ -374,3 +374,36 @@ fn each_bad_body_is_refused_with_its_key() {
         assert_refused(code, &stderr, expected);
     }
 }
+
+#[test]
+fn each_bad_trajectory_is_refused_with_its_key() {
+    let dir = TempDir::new("bad-trajectories");
+    std::fs::write(
+        dir.path().join("backwards.csv"),
+        "time,x,y,angle\n0.0,0,0,0\n0.5,0,0,1\n0.4,0,0,2\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("short.csv"),
+        "time,x,y,angle\n0.0,0,0,0\n0.001,0,0,1\n",
+    )
+    .unwrap();
+    let circle =
+        "[[body]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0";
+    let cases: &[(String, &[&str])] = &[
+        (format!("{circle}\nmotion = \"prescribed\""), &["body[0]", "no [body.trajectory]"]),
+        (format!("{circle}\n[body.trajectory]\nperiod = 1.0\nangle = 5.0"), &["body[0].trajectory", "prescribed body"]),
+        (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 1.0\ntable = \"short.csv\""), &["body[0].trajectory.table", "both given"]),
+        (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\ntable = \"backwards.csv\""), &["body[0].trajectory.table", "line 4", "times must increase"]),
+        (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\ntable = \"short.csv\""), &["body[0].trajectory.table", "before `simulation.end_time`"]),
+        (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\ntable = \"missing.csv\""), &["body[0].trajectory.table", "cannot read"]),
+        (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 1.0"), &["body[0].trajectory", "gives no motion"]),
+        (format!("{circle}\nrelease = 1.0"), &["body[0].release", "fixed or prescribed"]),
+        ("[container.trajectory]\nperiod = -1.0\nangle = 4.0".to_string(), &["container.trajectory.period", "positive"]),
+        ("[container.trajectory]\nperiod = 1.0\nangle = 4.0\naxis = [0.0, 0.0, 1.0]".to_string(), &["container.trajectory.axis", "for 3D"]),
+    ];
+    for (text, expected) in cases {
+        let (code, stderr) = run_text(dir.path(), &format!("{}\n{text}\n", good()), &[]);
+        assert_refused(code, &stderr, expected);
+    }
+}

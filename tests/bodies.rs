@@ -368,3 +368,121 @@ density = 1000.0
         .count();
     assert_eq!(bodies, inside);
 }
+
+/// The slope of body 0's vy over the frames from `from` to `to` s: its acceleration.
+fn acceleration(rows: &[(f64, Vec<f64>)], from: f64, to: f64) -> f64 {
+    let at = |t: f64| {
+        rows.iter()
+            .find(|r| (r.0 - t).abs() < 1e-9)
+            .unwrap_or_else(|| panic!("no row at t = {t}"))
+            .1[VY]
+    };
+    (at(to) - at(from)) / (to - from)
+}
+
+#[test]
+fn a_cylinder_lifted_by_its_weight_starts_at_the_added_mass_acceleration() {
+    // The paper's water exit at release: a 2D circle deep in still water (D/dx = 20) lifted by
+    // a constant force equal to its weight accelerates at a0 = ρf g/(ρs + Ca ρf), Ca = 1 for a
+    // circle in 2D (potential flow): the added mass is in the pressure solve, so no density
+    // ratio needs a smaller step. Measured between the second and the fourth 0.01 s frame
+    // (the first steps close the half-spacing gap the fill leaves around a body).
+    for density in [500.0, 1000.0, 2000.0] {
+        let dir = TempDir::new("bodies-added-mass");
+        let weight = density * std::f64::consts::PI * 0.05 * 0.05 * 9.81;
+        let body = format!(
+            "[[body]]\nshape = \"circle\"\ncenter = [0.3, 0.25]\nradius = 0.05\ndensity = {density:?}\nforce = [0.0, {weight:?}]\n"
+        );
+        let scene = scene_from_text(&tank(2, 0.005, [0.6, 0.6, 0.0], 0.5, 0.01, &body));
+        run_scene(&scene, dir.path(), 0.04);
+        let a = acceleration(&rows(dir.path(), 0), 0.02, 0.04);
+        let a0 = 1000.0 * 9.81 / (density + 1000.0);
+        eprintln!(
+            "s = {}: a = {a} against {a0} ({:+.2}%)",
+            density / 1000.0,
+            100.0 * (a / a0 - 1.0)
+        );
+        assert!(
+            (a / a0 - 1.0).abs() < 0.05,
+            "s = {}: a = {a} m/s² against ρf g/(ρs + ρf) = {a0}",
+            density / 1000.0
+        );
+    }
+}
+
+#[test]
+fn a_cylinder_oscillated_in_still_water_follows_its_trajectory_and_feels_its_added_mass() {
+    // x = A sin ωt with A = D/20: KC = 2πA/D = 0.3, so the force is the added mass's,
+    // F = −Ca ρ V ẍ with Ca = 1 (drag and vortex shedding are of order KC smaller).
+    let dir = TempDir::new("bodies-oscillating");
+    let (amplitude, period, radius) = (0.005, 0.5, 0.05);
+    let body = format!(
+        "[[body]]\nshape = \"circle\"\ncenter = [0.3, 0.25]\nradius = {radius:?}\ndensity = 1000.0\nmotion = \"prescribed\"\n\n[body.trajectory]\nperiod = {period:?}\namplitude = [{amplitude:?}, 0.0]\n"
+    );
+    let scene = scene_from_text(&tank(2, 0.005, [0.6, 0.6, 0.0], 0.5, 0.01, &body));
+    run_scene(&scene, dir.path(), 1.0);
+    let rows = rows(dir.path(), 0);
+    let omega = 2.0 * std::f64::consts::PI / period;
+    let (mut fa, mut aa) = (0.0, 0.0);
+    for (t, r) in &rows {
+        let x = rows[0].1[0] + amplitude * (omega * t).sin();
+        assert!(
+            (r[0] - x).abs() < 1e-12,
+            "t = {t}: x = {} against {x}",
+            r[0]
+        );
+        assert!(r[Y] == rows[0].1[Y], "t = {t}: y = {}", r[Y]);
+        // The second half: after the start-up of the first period.
+        if *t >= 0.5 * rows.last().unwrap().0 {
+            let a = -amplitude * omega * omega * (omega * t).sin();
+            fa += r[FY - 1] * a;
+            aa += a * a;
+        }
+    }
+    let volume = std::f64::consts::PI * radius * radius;
+    let ca = -fa / aa / (1000.0 * volume);
+    eprintln!("Ca = {ca}");
+    assert!(
+        (ca - 1.0).abs() < 0.05,
+        "added-mass coefficient {ca} against 1"
+    );
+}
+
+#[test]
+fn a_fixed_body_in_still_water_feels_its_buoyancy_and_leaves_the_water_still() {
+    let dir = TempDir::new("bodies-fixed");
+    let body = r#"[[body]]
+shape = "circle"
+center = [0.3, 0.25]
+radius = 0.05
+density = 1000.0
+motion = "fixed"
+"#;
+    let scene = scene_from_text(&tank(2, 0.005, [0.6, 0.6, 0.0], 0.5, 0.01, body));
+    run_scene(&scene, dir.path(), 0.5);
+    let rows = rows(dir.path(), 0);
+    let particles = body_positions(dir.path(), 0).len() as f64;
+    let buoyancy = 1000.0 * 9.81 * particles * 0.005 * 0.005;
+    let fy = mean_after(&rows, FY, 0.1);
+    eprintln!("fy {fy} against {buoyancy}");
+    assert!(
+        (fy / buoyancy - 1.0).abs() < 0.02,
+        "fy {fy} N/m against the buoyancy {buoyancy}"
+    );
+    for (t, r) in &rows {
+        assert!(r[..2] == rows[0].1[..2], "t = {t}: moved to {:?}", &r[..2]);
+    }
+    // The water closes the gap the fill left around the body, then calms down.
+    let speeds = stats_column(dir.path(), "max_speed");
+    let late = speeds[speeds.len() / 2..]
+        .iter()
+        .fold(0.0, |m: f64, s| m.max(*s));
+    let early = speeds[..speeds.len() / 10]
+        .iter()
+        .fold(0.0, |m: f64, s| m.max(*s));
+    eprintln!("max speed early {early}, late {late}");
+    assert!(
+        late < early,
+        "the water around a fixed body speeds up: {early} → {late} m/s"
+    );
+}

@@ -16,7 +16,10 @@ const RULES: &[(&str, &[&str])] = &[
         &["math", "scene::BodyMotion", "scene::Scene", "particles"],
     ),
     ("neighbours", &["math", "particles"]),
-    ("boundary", &["math", "particles", "neighbours"]),
+    (
+        "boundary",
+        &["math", "scene::trajectory", "particles", "neighbours"],
+    ),
     ("sph", &["math", "particles", "neighbours", "boundary"]),
     // The Krylov solver and the multigrid never see particles.
     ("solver::krylov", &["math"]),

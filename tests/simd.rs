@@ -2,6 +2,7 @@
 //! twins: scalar sums over every pair of particles (O(N²)) with the scalar kernel, on a
 //! disordered block of fluid over a floor of wall particles, in 2D and 3D.
 
+use isph::boundary::ghosts::BodyForce;
 use isph::math::kernel::{Quintic, SUPPORT_IN_H};
 use isph::neighbours::cell_list::CellList;
 use isph::neighbours::Neighbours;
@@ -110,7 +111,7 @@ fn check<const D: usize>(n: i64) {
         row_vectors: &row_vectors,
         fluid_volume: &fluid_volume,
         gravity: [0.0; D],
-        ghost_gravity: [0.0; D],
+        ghost_force: BodyForce::Uniform([0.0; D]),
         interfaces: None,
     };
     let x: Vec<f64> = (0..nf).map(|i| phi(i) * phi(i)).collect();

@@ -87,6 +87,8 @@ pub struct RigidBody {
     /// contact's search).
     pub reach: f64,
     pub motion: BodyMotion,
+    /// The time a fixed or prescribed body is let go (`scene::Body::release`).
+    pub release: Option<f64>,
     /// M = Σ m_i [kg] (per metre of depth in 2D).
     pub mass: f64,
     /// Inertia tensor about the centre of mass in the body's own frame [kg m²]; in 2D only
@@ -101,7 +103,58 @@ pub struct RigidBody {
     pub state: RigidState,
 }
 
+/// Where a fixed or prescribed body is taken by the end of a step: its pose and velocities.
+#[derive(Clone, Copy, Debug)]
+pub struct RigidTarget {
+    pub centre: Vec3,
+    pub orientation: Quaternion,
+    pub velocity: Vec3,
+    pub angular_velocity: Vec3,
+}
+
 impl RigidBody {
+    /// How the body moves over the step from time t: as the scene says, or free once released.
+    pub fn motion_at(&self, t: f64) -> &BodyMotion {
+        match self.release {
+            Some(release) if t >= release => &BodyMotion::Free,
+            _ => &self.motion,
+        }
+    }
+
+    /// The pose and velocities a fixed or prescribed body has at t + dt when it moves as such
+    /// over the step from t (None for a free body).
+    pub fn target(&self, t: f64, dt: f64) -> Option<RigidTarget> {
+        match self.motion_at(t) {
+            BodyMotion::Free => None,
+            BodyMotion::Fixed => Some(RigidTarget {
+                centre: self.state.centre,
+                orientation: self.state.orientation,
+                velocity: [0.0; 3],
+                angular_velocity: [0.0; 3],
+            }),
+            BodyMotion::Prescribed(trajectory) => {
+                // The pivot moves by X and the body turns by θ about it (`scene::trajectory`).
+                let k = trajectory.at(t + dt);
+                let axis = trajectory.axis;
+                let orientation = Quaternion::from_rotation_vector(axis.map(|e| e * k.angle));
+                let rotation = orientation.matrix();
+                let pivot: Vec3 = std::array::from_fn(|d| trajectory.pivot[d] + k.displacement[d]);
+                let arm = rotation::apply(
+                    &rotation,
+                    std::array::from_fn(|d| self.centre_at_start[d] - trajectory.pivot[d]),
+                );
+                let angular_velocity = axis.map(|e| e * k.angular_velocity);
+                let turn = cross(angular_velocity, arm);
+                Some(RigidTarget {
+                    centre: std::array::from_fn(|d| pivot[d] + arm[d]),
+                    orientation,
+                    velocity: std::array::from_fn(|d| k.velocity[d] + turn[d]),
+                    angular_velocity,
+                })
+            }
+        }
+    }
+
     /// The rotation matrix of the orientation.
     pub fn rotation(&self) -> Mat3 {
         self.state.orientation.matrix()
@@ -196,7 +249,8 @@ impl Bodies {
                     shape: body.shape.clone(),
                     centre_at_start: centre,
                     reach,
-                    motion: body.motion,
+                    motion: body.motion.clone(),
+                    release: body.release,
                     mass,
                     inertia,
                     external_force: std::array::from_fn(|d| {
@@ -217,6 +271,18 @@ impl Bodies {
                         torque: [0.0; 3],
                     },
                 }
+            })
+            .collect::<Vec<RigidBody>>();
+        let bodies = bodies
+            .into_iter()
+            .map(|mut body| {
+                // A prescribed body starts moving as its trajectory does at t = 0.
+                if let Some(target) = body.target(0.0, 0.0) {
+                    body.state.velocity = target.velocity;
+                    body.state.angular_momentum =
+                        rotation::apply(&body.inertia, target.angular_velocity);
+                }
+                body
             })
             .collect();
         let c: &Aabb = &scene.container;
@@ -264,55 +330,61 @@ impl Bodies {
         true
     }
 
-    /// Advances body b's state over `dt` from the momentum `impulse` and angular momentum
-    /// `angular_impulse` the step's fluid stages gave its particles beyond their rigid motion
-    /// (gravity included), then keeps it off the container's faces (`keep_inside`).
+    /// Advances body b's state over the step from `time` to `time + dt` from the momentum
+    /// `impulse` and angular momentum `angular_impulse` the step's fluid stages gave its particles
+    /// beyond their rigid motion, `applied` and `applied_torque` of them the body forces' (the
+    /// sums of m_i f_i and r_ic × m_i f_i, `ghosts::BodyForce`); a free body is then kept off the
+    /// container's faces (`keep_inside`), a fixed or prescribed one put where its motion says.
     pub fn advance(
         &mut self,
         b: usize,
         impulse: Vec3,
         angular_impulse: Vec3,
-        gravity: Vec3,
+        applied: [Vec3; 2],
+        time: f64,
         dt: f64,
     ) {
         let (faces, spacing) = (&self.faces, self.spacing);
         let body = &mut self.bodies[b];
         let s = body.state;
         let (force, torque) = (
-            std::array::from_fn(|d| impulse[d] / dt - body.mass * gravity[d]),
-            angular_impulse.map(|t| t / dt),
+            std::array::from_fn(|d| impulse[d] / dt - applied[0][d]),
+            std::array::from_fn(|d| angular_impulse[d] / dt - applied[1][d]),
         );
-        match body.motion {
-            BodyMotion::Fixed => {
-                body.state.force = force;
-                body.state.torque = torque;
-            }
-            BodyMotion::Free => {
-                // Eq. (14): the momentum balance; the trapezoid for the centre is exact under a
-                // constant force (free fall).
-                let velocity: Vec3 = std::array::from_fn(|d| {
-                    s.velocity[d] + (impulse[d] + dt * body.external_force[d]) / body.mass
-                });
-                let centre =
-                    std::array::from_fn(|d| s.centre[d] + 0.5 * dt * (s.velocity[d] + velocity[d]));
-                let angular_momentum =
-                    std::array::from_fn(|d| s.angular_momentum[d] + angular_impulse[d]);
-                body.state = RigidState {
-                    velocity,
-                    angular_momentum,
-                    force,
-                    torque,
-                    ..s
-                };
-                // Eq. (15)–(16): turn by ωⁿ⁺¹ Δt.
-                let w = body.angular_velocity();
-                body.state.orientation = Quaternion::from_rotation_vector(w.map(|w| w * dt))
-                    .then_after(s.orientation)
-                    .normalised();
-                body.state.centre = centre;
-                keep_inside(body, faces, spacing);
-            }
+        if let Some(target) = body.target(time, dt) {
+            body.state = RigidState {
+                centre: target.centre,
+                orientation: target.orientation,
+                velocity: target.velocity,
+                angular_momentum: rotation::apply(
+                    &rotation::to_world(&target.orientation.matrix(), &body.inertia),
+                    target.angular_velocity,
+                ),
+                force,
+                torque,
+            };
+            return;
         }
+        // Eq. (14): the momentum balance; the trapezoid for the centre is exact under a
+        // constant force (free fall).
+        let velocity: Vec3 = std::array::from_fn(|d| s.velocity[d] + impulse[d] / body.mass);
+        let centre =
+            std::array::from_fn(|d| s.centre[d] + 0.5 * dt * (s.velocity[d] + velocity[d]));
+        let angular_momentum = std::array::from_fn(|d| s.angular_momentum[d] + angular_impulse[d]);
+        body.state = RigidState {
+            velocity,
+            angular_momentum,
+            force,
+            torque,
+            ..s
+        };
+        // Eq. (15)–(16): turn by ωⁿ⁺¹ Δt.
+        let w = body.angular_velocity();
+        body.state.orientation = Quaternion::from_rotation_vector(w.map(|w| w * dt))
+            .then_after(s.orientation)
+            .normalised();
+        body.state.centre = centre;
+        keep_inside(body, faces, spacing);
     }
 }
 

@@ -56,20 +56,51 @@ pub fn motion<const D: usize>(_p: &Particles<D>, _l: &Lanes<D>) -> Motion<D> {
     Motion::AT_REST
 }
 
-/// P_b − P_i = −ρ0_i (g − a_b)·N_b r_ib of the ghost pressures of the wall particles b in
+/// The body force per unit mass on the fluid particles, which the Neumann condition of the
+/// wall ghosts carries: gravity alone, or a field over the fluid particles where it varies
+/// (a moving container's frame, `moving_frame`; a body's external force).
+#[derive(Clone, Copy, Debug)]
+pub enum BodyForce<'a, const D: usize> {
+    Uniform([f64; D]),
+    /// f_i of each fluid particle i, by component.
+    Field(&'a [Vec<f64>; D]),
+}
+
+impl<const D: usize> BodyForce<'_, D> {
+    /// f_i of fluid particle i.
+    #[inline(always)]
+    pub fn at(&self, i: usize) -> [f64; D] {
+        match self {
+            BodyForce::Uniform(g) => *g,
+            BodyForce::Field(f) => std::array::from_fn(|d| f[d][i]),
+        }
+    }
+
+    /// f_j of the fluid particles j in lanes `l`.
+    #[inline(always)]
+    pub fn lanes(&self, l: &Lanes<D>) -> [F64s; D] {
+        match self {
+            BodyForce::Uniform(g) => g.map(F64s::splat),
+            BodyForce::Field(f) => std::array::from_fn(|d| l.load(&f[d])),
+        }
+    }
+}
+
+/// P_b − P_i = −ρ0_i (f_i − a_b)·N_b r_ib of the ghost pressures of the wall particles b in
 /// lanes `l` seen from fluid particle i (r_ib = r_i − r_b, the lanes' r_ij): the Neumann
-/// condition ∂P/∂n = ρ0 (g − a_b)·n of a wall accelerating at a_b (`motion`).
+/// condition ∂P/∂n = ρ0 (f − a_b)·n of a wall accelerating at a_b (`motion`), with f_i the
+/// body force on i (gravity, in a moving container the frame's, `moving_frame`).
 #[inline(always)]
 pub fn ghost_pressure_difference<const D: usize>(
     p: &Particles<D>,
-    gravity: [f64; D],
+    force: [f64; D],
     i: usize,
     l: &Lanes<D>,
 ) -> F64s {
     let across = behind_walls(p, l, l.rij);
     let a_b = motion(p, l).acceleration;
     let g_r = (0..D).fold(F64s::ZERO, |s, d| {
-        (F64s::splat(gravity[d]) - a_b[d]).mul_add(across[d], s)
+        (F64s::splat(force[d]) - a_b[d]).mul_add(across[d], s)
     });
     F64s::splat(-p.rest_density[i]) * g_r
 }
@@ -137,7 +168,8 @@ const MORRIS_BETA_MAX: f64 = 4.0;
 pub struct Ghosts<'a, const D: usize> {
     pub rest_density: &'a [f64],
     pub normal: &'a [Vec<f64>; D],
-    pub gravity: [f64; D],
+    /// The body force the ghosts carry (zero with mirror ghosts).
+    pub force: BodyForce<'a, D>,
 }
 
 impl<const D: usize> Ghosts<'_, D> {
@@ -145,18 +177,19 @@ impl<const D: usize> Ghosts<'_, D> {
     /// ghost pressures its fluid neighbours give it (zero where no fluid is in reach), with
     /// `fluid_pressure` the pressures of the fluid particles.
     pub fn wall_pressure(&self, nb: &Neighbours<D>, fluid_pressure: &[f64], b: usize) -> f64 {
-        // P_b − P_f = −ρ0_f g·N_b r_fb (see the module doc), r_fb = −r_bf; N_b is b's own.
-        let g_across: [F64s; D] = std::array::from_fn(|d| {
-            F64s::splat(if self.normal[d][b] != 0.0 {
-                self.gravity[d]
-            } else {
-                0.0
-            })
-        });
+        // P_b − P_f = −ρ0_f f_f·N_b r_fb (see the module doc), r_fb = −r_bf; N_b is b's own.
+        let behind: [bool; D] = std::array::from_fn(|d| self.normal[d][b] != 0.0);
         let (mut sum, mut weights) = (Sum::ZERO, Sum::ZERO);
         nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
             let w = nb.kernel.w_lanes(l.r) & l.mask;
-            let g_r = (0..D).fold(F64s::ZERO, |s, d| g_across[d].mul_add(l.rij[d], s));
+            let f = self.force.lanes(l);
+            let g_r = (0..D).fold(F64s::ZERO, |s, d| {
+                if behind[d] {
+                    f[d].mul_add(l.rij[d], s)
+                } else {
+                    s
+                }
+            });
             let ghost = l
                 .load(self.rest_density)
                 .mul_add(g_r, l.load(fluid_pressure));

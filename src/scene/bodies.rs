@@ -1,24 +1,28 @@
 //! `[[body]]`: rigid bodies in the fluid (docs/bodies.md, docs/scene-format.md).
 
+use super::trajectory::Trajectory;
 pub use crate::math::shape::Shape;
 
 /// How a body moves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum BodyMotion {
     /// Moved by gravity, the fluid, its constant external force and the contact with the walls.
     Free,
     /// Held where it starts; the fluid's force on it is still measured.
     Fixed,
+    /// Moved on a trajectory whatever the fluid does; the fluid's force on it is measured.
+    Prescribed(Trajectory),
 }
 
 impl BodyMotion {
-    pub const NAMES: [&'static str; 2] = ["free", "fixed"];
+    pub const NAMES: [&'static str; 3] = ["free", "fixed", "prescribed"];
 
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "free" => Some(Self::Free),
-            "fixed" => Some(Self::Fixed),
-            _ => None,
+    /// Its name in the scene file and `isph plan`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Free => "free",
+            Self::Fixed => "fixed",
+            Self::Prescribed(_) => "prescribed",
         }
     }
 }
@@ -40,6 +44,8 @@ pub struct Body {
     pub shape: Shape,
     pub mass: BodyMass,
     pub motion: BodyMotion,
+    /// The time [s] a fixed or prescribed body is let go and moves freely from (None: never).
+    pub release: Option<f64>,
     /// A constant external force on the body [N] (per metre of depth in 2D), besides gravity.
     pub force: Vec<f64>,
     /// The ratio of the speed off a wall to the speed into it in a contact (0: the body stops).

@@ -52,6 +52,21 @@ pub(super) struct BodySection {
     pub(super) restitution: Option<f64>,
     pub(super) velocity: Option<Vec<f64>>,
     pub(super) angular_velocity: Option<Vec<f64>>,
+    pub(super) trajectory: Option<TrajectorySection>,
+    pub(super) release: Option<f64>,
+}
+
+/// `[container.trajectory]` and `[body.trajectory]` as written: a sinusoid (`period`,
+/// `amplitude`, `angle`) or a `table` file (docs/scene-format.md).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TrajectorySection {
+    pub(super) pivot: Option<Vec<f64>>,
+    pub(super) axis: Option<Vec<f64>>,
+    pub(super) period: Option<f64>,
+    pub(super) amplitude: Option<Vec<f64>>,
+    pub(super) angle: Option<f64>,
+    pub(super) table: Option<String>,
 }
 
 /// `[[probe]]` as written (docs/scene-format.md).
@@ -115,6 +130,7 @@ pub(super) struct ContainerSection {
     pub(super) min: Vec<f64>,
     pub(super) max: Vec<f64>,
     pub(super) periodic: Option<Vec<bool>>,
+    pub(super) trajectory: Option<TrajectorySection>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

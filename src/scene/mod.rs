@@ -6,6 +6,7 @@ mod effects;
 mod file;
 mod probes;
 mod surface;
+pub mod trajectory;
 mod validate;
 
 pub use bodies::{Body, BodyMass, BodyMotion, Shape};
@@ -166,6 +167,9 @@ pub struct Scene {
     /// leaves through one comes back through the other).
     pub periodic: Vec<bool>,
     pub obstacles: Vec<Aabb>,
+    /// `[container.trajectory]`: the container's prescribed motion, with its walls and obstacles
+    /// (None: at rest). The particles move in its frame (`boundary::moving_frame`).
+    pub container_motion: Option<trajectory::Trajectory>,
     /// The fluid's velocity at t = 0 (None: at rest).
     pub initial_velocity: Option<InitialVelocity>,
     pub solver: SolverSettings,

@@ -16,7 +16,7 @@
 //! fluid neighbours (`ghosts::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
 //! first in the sorted order).
 
-use crate::boundary::ghosts::{behind_walls, ghost_pressure_difference, ghost_velocity};
+use crate::boundary::ghosts::{behind_walls, ghost_pressure_difference, ghost_velocity, BodyForce};
 use crate::math::lanes::{F64s, Sum, LANES};
 use crate::math::reduce::{fill, fill_vector};
 use crate::neighbours::Lanes;
@@ -425,8 +425,8 @@ pub struct PressureOperator<'a, const D: usize> {
     /// V_j = m_j/ρ0_j of the fluid particles, the unknowns the rows couple (`fluid_volumes`).
     pub fluid_volume: &'a [f64],
     pub gravity: [f64; D],
-    /// The gravity the wall ghosts' pressures carry (`StepSettings::ghost_gravity`).
-    pub ghost_gravity: [f64; D],
+    /// The body force the wall ghosts' pressures carry (zero with mirror ghosts).
+    pub ghost_force: BodyForce<'a, D>,
     /// Where the fluids differ in rest density, each fluid particle's distance to the nearest
     /// interface (`interior_weights`).
     pub interfaces: Option<Field<'a, D>>,
@@ -490,7 +490,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
             let volume = l.load(&p.mass) / l.load(&p.rest_density);
             let w = self.interior_weights(&row, l, volume);
-            b += w * ghost_pressure_difference(p, self.ghost_gravity, i, l);
+            b += w * ghost_pressure_difference(p, self.ghost_force.at(i), i, l);
         });
         b.total()
     }

@@ -5,7 +5,7 @@
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
 use crate::boundary::faces::{self, Faces};
-use crate::boundary::ghosts;
+use crate::boundary::ghosts::{self, BodyForce};
 use crate::math::lanes::F64s;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_vector_and_update;
@@ -30,7 +30,8 @@ impl<const D: usize> Default for Corrector<D> {
 }
 
 impl<const D: usize> Corrector<D> {
-    /// uⁿ⁺¹ of the fluid particles from `u_star`, which then holds ∇Pⁿ⁺¹.
+    /// uⁿ⁺¹ of the fluid particles from `u_star`, which then holds ∇Pⁿ⁺¹; `force` is the body
+    /// force field where it is not gravity alone (`body_forces`).
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -40,6 +41,7 @@ impl<const D: usize> Corrector<D> {
         faces: &Faces,
         surface: &Surface<D>,
         interfaces: Option<interface::Field<D>>,
+        force: Option<&[Vec<f64>; D]>,
         u_star: &mut [Vec<f64>; D],
         dt: f64,
     ) -> &[Vec<f64>; D] {
@@ -48,7 +50,7 @@ impl<const D: usize> Corrector<D> {
             a.resize(n, 0.0);
         }
         let touch = faces::touching_distance(set.spacing);
-        let ghost = set.ghost_gravity();
+        let ghost = set.ghost_force(force);
         fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
             let grad = pressure_gradient(nb, p, &p.pressure, surface, ghost, interfaces, i);
             let rho0 = p.rest_density[i];
@@ -84,7 +86,7 @@ impl<const D: usize> Stage<D> for Corrector<D> {
 /// ∇P_i of the fluid pressures `pressure` at fluid particle i with the gradient corrected by
 /// `surface`'s pressure corrections (Eq. 20, 24–25), the differences taken from the pressure
 /// reference of its role there (`pressure_reference`), and the walls
-/// as ghosts of P_i (see `ghosts`) carrying `ghost_gravity` (zero: mirror ghosts): a particle whose pressure exceeds p_ref is pushed off a wall it
+/// as ghosts of P_i (see `ghosts`) carrying the body force `ghost_force` (zero: mirror ghosts): a particle whose pressure exceeds p_ref is pushed off a wall it
 /// presses on, but not out through a free surface; across the interface of two fluids
 /// (`interfaces`, the distances to it) each difference is weighted by ρ0_i/ρ̄_ij
 /// (`interface::Side::across`).
@@ -93,7 +95,7 @@ pub(super) fn pressure_gradient<const D: usize>(
     p: &Particles<D>,
     pressure: &[f64],
     surface: &Surface<D>,
-    ghost_gravity: [f64; D],
+    ghost_force: BodyForce<D>,
     interfaces: Option<interface::Field<D>>,
     i: usize,
 ) -> [f64; D] {
@@ -105,7 +107,7 @@ pub(super) fn pressure_gradient<const D: usize>(
     let own = F64s::splat(pressure[i]) - p_ref;
     sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
         Kind::Fluid | Kind::Body => side.across(p, interfaces, lanes, lanes.load(pressure) - p_ref),
-        Kind::Wall => own + ghosts::ghost_pressure_difference(p, ghost_gravity, i, lanes),
+        Kind::Wall => own + ghosts::ghost_pressure_difference(p, ghost_force.at(i), i, lanes),
     })
 }
 

@@ -17,6 +17,7 @@ use super::corrector::pressure_gradient;
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
 use crate::boundary::faces::{self, Faces};
+use crate::boundary::ghosts::BodyForce;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_vector;
 use crate::neighbours::Neighbours;
@@ -60,7 +61,7 @@ impl<const D: usize> DensityCorrection<D> {
         }
         let touch = faces::touching_distance(set.spacing);
         // The correction's walls are mirror ghosts: no gravity in their differences.
-        let mirror = [0.0; D];
+        let mirror = BodyForce::Uniform([0.0; D]);
         fill_vector(&mut self.displacement, |i| {
             // Splashes stay in place; a body's particles move rigidly (`rigid_bodies`).
             if surface.roles[i] == Role::Splash || p.kind[i] == Kind::Body {

@@ -25,6 +25,7 @@
 //! `Step::stages`; its settings are a section of the scene (`scene::Effects`).
 
 mod advection;
+mod body_forces;
 mod cell_list;
 mod corrector;
 mod density;
@@ -44,7 +45,8 @@ mod wall_pressure;
 
 use crate::bodies::Bodies;
 use crate::boundary::faces::Faces;
-use crate::boundary::ghosts;
+use crate::boundary::ghosts::{self, BodyForce};
+use crate::boundary::moving_frame::MovingFrame;
 use crate::math::kernel::Quintic;
 use crate::math::memory::{ArraySize, Holds};
 use crate::math::reduce::fill;
@@ -87,13 +89,19 @@ pub struct StepSettings<const D: usize> {
 }
 
 impl<const D: usize> StepSettings<D> {
-    /// The gravity the wall ghosts' pressures carry: `gravity` with hydrostatic ghosts, zero
-    /// with mirror ghosts.
-    pub fn ghost_gravity(&self) -> [f64; D] {
-        match self.ghost_pressure {
-            GhostPressure::Hydrostatic => self.gravity,
-            GhostPressure::Mirror => [0.0; D],
+    /// The body force the wall ghosts' pressures carry with hydrostatic ghosts (zero with
+    /// mirror ghosts): `field` where the body force varies (`body_forces`), else gravity.
+    pub fn ghost_force<'a>(&self, field: Option<&'a [Vec<f64>; D]>) -> BodyForce<'a, D> {
+        match (self.ghost_pressure, field) {
+            (GhostPressure::Mirror, _) => BodyForce::Uniform([0.0; D]),
+            (GhostPressure::Hydrostatic, Some(f)) => BodyForce::Field(f),
+            (GhostPressure::Hydrostatic, None) => BodyForce::Uniform(self.gravity),
         }
+    }
+
+    /// The body force the predictor adds: `field` where it varies, else gravity.
+    pub fn body_force<'a>(&self, field: Option<&'a [Vec<f64>; D]>) -> BodyForce<'a, D> {
+        field.map_or(BodyForce::Uniform(self.gravity), BodyForce::Field)
     }
 }
 
@@ -163,6 +171,7 @@ pub struct Step<const D: usize> {
     free_surface: free_surface::FreeSurface<D>,
     kernel_correction: Option<kernel_correction::KernelCorrection<D>>,
     eddy_viscosity: Option<eddy_viscosity::EddyViscosity>,
+    body_forces: Option<body_forces::BodyForces<D>>,
     predictor: predictor::Predictor<D>,
     pressure_solve: pressure_solve::PressureSolve<D>,
     corrector: corrector::Corrector<D>,
@@ -177,7 +186,8 @@ pub struct Step<const D: usize> {
 impl<const D: usize> Step<D> {
     /// The step of a scene with `settings`, on `grid`; `interfaces` is the kernel's table of
     /// distances to an interface where the fluids differ in rest density (None: one density);
-    /// `bodies` whether the scene has rigid bodies.
+    /// `bodies` whether the scene has rigid bodies; `frame` the container's motion (None: at
+    /// rest).
     pub fn new(
         settings: StepSettings<D>,
         kernel: Quintic<D>,
@@ -185,6 +195,7 @@ impl<const D: usize> Step<D> {
         grid: CellList<D>,
         interfaces: Option<Interfaces>,
         bodies: bool,
+        frame: Option<MovingFrame>,
     ) -> Self {
         let effects = &settings.effects;
         Self {
@@ -197,6 +208,7 @@ impl<const D: usize> Step<D> {
                 .kernel_correction
                 .then(kernel_correction::KernelCorrection::default),
             eddy_viscosity: effects.les.map(eddy_viscosity::EddyViscosity::new),
+            body_forces: (bodies || frame.is_some()).then(|| body_forces::BodyForces::new(frame)),
             predictor: predictor::Predictor::default(),
             pressure_solve: pressure_solve::PressureSolve::new(settings.alpha > 0.0),
             corrector: corrector::Corrector::default(),
@@ -227,6 +239,9 @@ impl<const D: usize> Step<D> {
             stages.push(s);
         }
         if let Some(s) = &self.eddy_viscosity {
+            stages.push(s);
+        }
+        if let Some(s) = &self.body_forces {
             stages.push(s);
         }
         stages.extend([
@@ -320,7 +335,15 @@ impl<const D: usize> Step<D> {
                 laps.lap(eddy_viscosity::NAME);
                 eddy
             });
-            let u_star = self.predictor.run(&nb, p, set, eddy, dt, nf);
+            let force = self.body_forces.as_mut().map(|stage| {
+                let surface = self.free_surface.output();
+                let force = stage.run(&nb, p, bodies, set, &surface, interfaces, time, dt, nf);
+                laps.lap(body_forces::NAME);
+                force
+            });
+            let u_star = self
+                .predictor
+                .run(&nb, p, set, eddy, set.body_force(force), dt, nf);
             laps.lap(predictor::NAME);
             let surface = &mut self.free_surface;
             let solve = self
@@ -332,6 +355,7 @@ impl<const D: usize> Step<D> {
                     surface,
                     corrections,
                     interfaces,
+                    force,
                     u_star,
                     length,
                     probe,
@@ -344,13 +368,22 @@ impl<const D: usize> Step<D> {
             fill(&mut p.pressure[..nf], |i| cavitation(clip, solved[i]));
             fill(&mut p.free_surface[..nf], |i| surface.roles[i].code());
             laps.lap(pressure_solve::NAME);
-            self.corrector
-                .run(&nb, p, set, &self.faces, &surface, interfaces, u_star, dt);
+            self.corrector.run(
+                &nb,
+                p,
+                set,
+                &self.faces,
+                &surface,
+                interfaces,
+                force,
+                u_star,
+                dt,
+            );
             let grad_p = &*u_star;
             laps.lap(corrector::NAME);
             let velocity = self.corrector.velocity_scratch();
-            if let Some(stage) = &mut self.rigid_bodies {
-                stage.run(&nb, p, bodies, set, velocity, dt);
+            if let (Some(stage), Some(force)) = (&mut self.rigid_bodies, force) {
+                stage.run(&nb, p, bodies, force, velocity, time, dt);
                 laps.lap(rigid_bodies::NAME);
             }
             // Into the particles: uⁿ⁺¹ (the bodies' rigid).
@@ -362,7 +395,7 @@ impl<const D: usize> Step<D> {
                 let ghosts = ghosts::Ghosts {
                     rest_density: &p.rest_density,
                     normal: &p.normal,
-                    gravity: set.ghost_gravity(),
+                    force: set.ghost_force(force),
                 };
                 // Into the particles: the walls' P, for the frame.
                 self.wall_pressure.run(&nb, &ghosts, &mut p.pressure, nf);

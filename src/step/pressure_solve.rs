@@ -80,6 +80,7 @@ impl<const D: usize> PressureSolve<D> {
         surface: &mut FreeSurface<D>,
         corrections: Corrections<D>,
         interfaces: Option<interface::Field<D>>,
+        force: Option<&[Vec<f64>; D]>,
         u_star: &[Vec<f64>; D],
         step: StepLength,
         probe: Option<&mut dyn FnMut(&PressureOperator<D>)>,
@@ -103,6 +104,7 @@ impl<const D: usize> PressureSolve<D> {
             set,
             surface,
             interfaces,
+            force,
             |op, mg, sealed, s| {
                 if let Some(probe) = probe {
                     probe(op);
@@ -179,6 +181,7 @@ fn with_operator<const D: usize, R>(
     set: &StepSettings<D>,
     surface: &mut FreeSurface<D>,
     interfaces: Option<interface::Field<D>>,
+    force: Option<&[Vec<f64>; D]>,
     solve: impl FnOnce(
         &PressureOperator<D>,
         &mut Multigrid<D>,
@@ -212,7 +215,7 @@ fn with_operator<const D: usize, R>(
             row_vectors: &rows.row_vectors,
             fluid_volume: &rows.fluid_volume,
             gravity: set.gravity,
-            ghost_gravity: set.ghost_gravity(),
+            ghost_force: set.ghost_force(force),
             interfaces,
         };
         multigrid.setup(&op)?;

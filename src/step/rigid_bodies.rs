@@ -19,16 +19,19 @@ pub struct RigidBodies {
 }
 
 impl RigidBodies {
-    /// Advances `bodies` over `dt` from `velocity`, the corrector's uⁿ⁺¹ of the `nf` fluid and
-    /// body particles, and puts their rigid velocities there. The sums run over the particles
-    /// in the sorted order, one thread: the same bits whatever the thread count.
+    /// Advances `bodies` over the step of `dt` from `time` from `velocity`, the corrector's
+    /// uⁿ⁺¹ of the `nf` fluid and body particles, and puts their rigid velocities there;
+    /// `force` is the body force f_i the predictor gave them (`body_forces`). The sums run over
+    /// the particles in the sorted order, one thread: the same bits whatever the thread count.
+    #[allow(clippy::too_many_arguments)]
     pub fn run<const D: usize>(
         &mut self,
         nb: &Neighbours<D>,
         p: &Particles<D>,
         bodies: &mut Bodies,
-        set: &StepSettings<D>,
+        force: &[Vec<f64>; D],
         velocity: &mut [Vec<f64>; D],
+        time: f64,
         dt: f64,
     ) {
         let nf = velocity[0].len();
@@ -37,6 +40,8 @@ impl RigidBodies {
             .extend((0..nf as u32).filter(|&i| p.kind[i as usize] == Kind::Body));
         let count = bodies.bodies.len();
         let (mut impulse, mut angular) = (vec![[0.0; 3]; count], vec![[0.0; 3]; count]);
+        // Σ m_i f_i and Σ r_ic × m_i f_i: the body forces' part of the impulses.
+        let mut applied = vec![[[0.0; 3]; 2]; count];
         let mut touched = vec![false; count];
         let rigid_now: Vec<_> = bodies
             .bodies
@@ -58,23 +63,27 @@ impl RigidBodies {
                 }
             });
             let t = cross(arm, du);
+            let mf: Vec3 =
+                std::array::from_fn(|d| if d < D { p.mass[i] * force[d][i] } else { 0.0 });
+            let mf_t = cross(arm, mf);
             for d in 0..3 {
                 impulse[b][d] += du[d];
                 angular[b][d] += t[d];
+                applied[b][0][d] += mf[d];
+                applied[b][1][d] += mf_t[d];
             }
             touched[b] = touched[b] || touches_another(nb, p, i);
         }
-        let gravity: Vec3 = std::array::from_fn(|d| if d < D { set.gravity[d] } else { 0.0 });
         for b in 0..count {
             if !touched[b] {
-                // Nothing but the body in reach of its particles: in the air it feels gravity
-                // alone, whatever the pressure solve left inside it (its rows are solved to the
-                // tolerance only); free fall is then exact to round-off.
-                let mass = bodies.bodies[b].mass;
-                impulse[b] = gravity.map(|g| mass * g * dt);
-                angular[b] = [0.0; 3];
+                // Nothing but the body in reach of its particles: in the air it feels its body
+                // forces alone (gravity and its external force), whatever the pressure solve
+                // left inside it (its rows are solved to the tolerance only); free fall is then
+                // exact to round-off.
+                impulse[b] = applied[b][0].map(|f| f * dt);
+                angular[b] = applied[b][1].map(|t| t * dt);
             }
-            bodies.advance(b, impulse[b], angular[b], gravity, dt);
+            bodies.advance(b, impulse[b], angular[b], applied[b], time, dt);
         }
         let poses: Vec<_> = bodies
             .bodies
@@ -143,7 +152,7 @@ impl<const D: usize> Stage<D> for RigidBodies {
     }
 
     fn describe(&self, _: &StepSettings<D>) -> String {
-        "Eq. (11)–(16): each body's momentum and angular momentum from its particles' corrected velocities; V, L, the centre (trapezoid) and the orientation quaternion advanced in f64; contact with the container's faces; the particles' velocities and positions set rigidly".into()
+        "Eq. (11)–(16): each free body's momentum and angular momentum from its particles' corrected velocities; V, L, the centre (trapezoid) and the orientation quaternion advanced in f64; contact with the container's faces; a fixed or prescribed body put where its motion says, the fluid's force on it measured; the particles' velocities and positions set rigidly".into()
     }
 
     fn arrays(&self) -> Vec<ArraySize> {

@@ -30,6 +30,8 @@ pub struct Plan {
     pub smoothing_length: f64,
     pub wall_layers: usize,
     pub effects: Effects,
+    /// The container's prescribed motion, described (None: at rest).
+    pub container_motion: Option<String>,
     /// `[output.surface]`, built at every frame (None: particles only).
     pub surface: Option<SurfaceSettings>,
     /// `[[probe]]`, read after every step into probes.csv.
@@ -94,7 +96,7 @@ impl Plan {
             .zip(displaced)
             .map(|(b, displaced)| PlannedBody {
                 name: b.name.clone(),
-                motion: b.motion,
+                motion: b.motion.clone(),
                 particles: b.offsets.len(),
                 mass: b.mass,
                 density: b.mass / (b.offsets.len() as f64 * volume),
@@ -111,6 +113,7 @@ impl Plan {
             smoothing_length: scene.smoothing_length(),
             wall_layers: scene.wall_layers(),
             effects: scene.effects,
+            container_motion: scene.container_motion.as_ref().map(|t| t.describe()),
             surface: scene.surface,
             probes: scene.probes.clone(),
             state_bytes_per_particle: state.iter().map(|(_, a)| a.element_bytes()).sum(),
@@ -189,14 +192,17 @@ impl fmt::Display for Plan {
             self.fluid_particles, self.wall_particles, self.smoothing_length, self.wall_layers
         )?;
         writeln!(f, "effects: {}", effects_line(&self.effects))?;
+        if let Some(motion) = &self.container_motion {
+            writeln!(f, "container moves, solved in its frame: {motion}")?;
+        }
         for b in &self.bodies {
             writeln!(
                 f,
                 "body {}: {} with {} particles, mass {:.4e} kg, density {:.1} kg/m³, inertia diag {} kg m²; displaces {} fluid lattice points",
                 b.name,
-                match b.motion {
-                    BodyMotion::Free => "free",
-                    BodyMotion::Fixed => "fixed",
+                match &b.motion {
+                    BodyMotion::Prescribed(t) => format!("prescribed ({})", t.describe()),
+                    m => m.name().to_string(),
                 },
                 b.particles,
                 b.mass,

@@ -1,6 +1,8 @@
 //! Checks a parsed scene file and turns it into a `Scene`: every error names the file, the
 //! key and, where it can be found, the line.
 
+mod trajectory;
+
 use super::file::{
     BodySection, BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection,
     ProbeSection, SceneFile, ShiftingSection, SimulationSection, SurfaceSection,
@@ -268,6 +270,22 @@ impl Validator<'_> {
             .map(|s| self.surface(s))
             .transpose()?;
         let probes = self.probes(&f.probe, &container)?;
+        let container_motion = f
+            .container
+            .trajectory
+            .as_ref()
+            .map(|t| {
+                let centre: Vec<f64> = (0..dims)
+                    .map(|d| 0.5 * (container.min[d] + container.max[d]))
+                    .collect();
+                self.trajectory(t, "container.trajectory", dims, &centre, s.end_time)
+            })
+            .transpose()?;
+        self.check(
+            container_motion.is_none() || !periodic.contains(&true),
+            "container.trajectory",
+            "is for a closed container: a periodic one cannot move (its frame's forces would not be periodic)",
+        )?;
         let bodies = self.bodies(&f.body, &container, &obstacles, s)?;
         self.check(
             bodies.is_empty() || !periodic.contains(&true),
@@ -310,6 +328,7 @@ impl Validator<'_> {
             container,
             periodic,
             obstacles,
+            container_motion,
             initial_velocity,
             solver: f.solver,
             checkpoint,
@@ -708,16 +727,7 @@ impl Validator<'_> {
                     ))
                 }
             };
-            let motion_name = b.motion.as_deref().unwrap_or("free");
-            let motion = BodyMotion::from_name(motion_name).ok_or_else(|| {
-                self.error(
-                    &format!("{key}.motion"),
-                    format!(
-                        "= \"{motion_name}\" is not a motion: one of {}",
-                        BodyMotion::NAMES.map(|n| format!("\"{n}\"")).join(", ")
-                    ),
-                )
-            })?;
+            let motion = self.body_motion(b, &key, dims, &shape, s)?;
             let force = b.force.clone().unwrap_or(vec![0.0; dims]);
             self.vector(&force, dims, &format!("{key}.force"))?;
             let restitution = b.restitution.unwrap_or(0.0);
@@ -744,13 +754,27 @@ impl Validator<'_> {
                 motion == BodyMotion::Free
                     || (velocity.iter().chain(&angular_velocity).all(|v| *v == 0.0)),
                 &format!("{key}.velocity"),
-                "and `angular_velocity` are for a free body: a fixed body starts at rest",
+                "and `angular_velocity` are for a free body: a fixed or prescribed body starts as its motion says",
             )?;
+            if let Some(release) = b.release {
+                let release_key = format!("{key}.release");
+                self.check(
+                    motion != BodyMotion::Free,
+                    &release_key,
+                    "is for a fixed or prescribed body (the time it is let go): a free body is free from the start",
+                )?;
+                self.check(
+                    release.is_finite() && release >= 0.0,
+                    &release_key,
+                    format!("= {release:?} must be a time ≥ 0 [s]"),
+                )?;
+            }
             bodies.push(Body {
                 name,
                 shape,
                 mass,
                 motion,
+                release: b.release,
                 force,
                 restitution,
                 velocity,
@@ -758,6 +782,51 @@ impl Validator<'_> {
             });
         }
         Ok(bodies)
+    }
+
+    /// The motion of `[[body]]` section `b` with `shape`: a known name, and a trajectory for a
+    /// prescribed body only (its pivot the shape's centre unless given).
+    fn body_motion(
+        &self,
+        b: &BodySection,
+        key: &str,
+        dims: usize,
+        shape: &Shape,
+        s: &SimulationSection,
+    ) -> Result<BodyMotion, SceneError> {
+        let name = b.motion.as_deref().unwrap_or("free");
+        let unknown = || {
+            self.error(
+                &format!("{key}.motion"),
+                format!(
+                    "= \"{name}\" is not a motion: one of {}",
+                    BodyMotion::NAMES.map(|n| format!("\"{n}\"")).join(", ")
+                ),
+            )
+        };
+        match (name, &b.trajectory) {
+            ("free", None) => Ok(BodyMotion::Free),
+            ("fixed", None) => Ok(BodyMotion::Fixed),
+            ("prescribed", Some(t)) => {
+                let bounds = shape.bounds();
+                let centre: Vec<f64> = (0..dims)
+                    .map(|d| 0.5 * (bounds.min[d] + bounds.max[d]))
+                    .collect();
+                let key = format!("{key}.trajectory");
+                Ok(BodyMotion::Prescribed(
+                    self.trajectory(t, &key, dims, &centre, s.end_time)?,
+                ))
+            }
+            ("prescribed", None) => Err(self.error(
+                key,
+                "has `motion = \"prescribed\"` but no [body.trajectory]: give its `period` (a sinusoid) or `table`",
+            )),
+            ("free" | "fixed", Some(_)) => Err(self.error(
+                &format!("{key}.trajectory"),
+                format!("is for a prescribed body: this one is `{name}`; set `motion = \"prescribed\"` or leave the trajectory out"),
+            )),
+            _ => Err(unknown()),
+        }
     }
 
     /// The shape of `[[body]]` section `b`: its `shape` known in `dims` dimensions, the keys
