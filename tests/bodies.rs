@@ -486,3 +486,40 @@ motion = "fixed"
         "the water around a fixed body speeds up: {early} → {late} m/s"
     );
 }
+
+#[test]
+fn the_sinking_cylinder_keeps_near_the_band_of_its_two_references() {
+    // scenes/sinking_cylinder_2d.toml (D/dx = 20): R = 1 m at s = 1.2 held half submerged for
+    // 1 s, then let go. Its displacement at T = (t − 1) √(g/R) = 1 … 4 against Fekken (2004)
+    // and Moyo & Greenhow (2000): inside their band widened by 10% of the nearer one (measured
+    // 3.5%, 7.3% and 1.2% beyond it at T = 1, 2, 3 and inside at T = 4; at D/dx = 40, 0% and
+    // 4.3% beyond at T = 1, 2, inside at T = 3, 4: docs/bodies.md, "Sinking cylinder").
+    let dir = TempDir::new("bodies-sinking-cylinder");
+    let scene = crate::common::shipped_scene("sinking_cylinder_2d.toml");
+    let release = 1.0;
+    let until = release + 4.0 / 9.81f64.sqrt();
+    run_scene(&scene, dir.path(), until + 0.05);
+    let rows = rows(dir.path(), 0);
+    let y_at = |t: f64| {
+        let k = rows.iter().position(|r| r.0 > t).unwrap();
+        let ((t0, a), (t1, b)) = ((rows[k - 1].0, rows[k - 1].1[Y]), (rows[k].0, rows[k].1[Y]));
+        a + (b - a) * (t - t0) / (t1 - t0)
+    };
+    let held = y_at(release);
+    assert!((held - 14.0).abs() < 1e-9, "held at {held}");
+    let fekken: [f64; 4] = [-0.198, -0.649, -1.166, -1.630];
+    let moyo_greenhow = [-0.154, -0.657, -1.292, -1.965];
+    for k in 0..4 {
+        let t = release + (k + 1) as f64 / 9.81f64.sqrt();
+        let d = y_at(t) - held;
+        let (a, b) = (fekken[k], moyo_greenhow[k]);
+        let (lo, hi) = (a.min(b), a.max(b));
+        let (lo, hi) = (lo + 0.1 * lo, hi - 0.1 * hi);
+        eprintln!("T = {}: {d} m (Fekken {a}, Moyo & Greenhow {b})", k + 1);
+        assert!(
+            (lo..=hi).contains(&d),
+            "T = {}: displacement {d} m outside [{lo}, {hi}]",
+            k + 1
+        );
+    }
+}

@@ -285,9 +285,20 @@ fn a_continued_3d_run_is_bit_identical_to_one_never_stopped() {
 }
 
 #[test]
-fn a_continued_run_with_a_floating_body_is_bit_identical_to_one_never_stopped() {
+fn a_continued_run_with_bodies_in_a_rolling_tank_is_bit_identical_to_one_never_stopped() {
     let dir = TempDir::new("ckpt-bodies");
-    let edits = [("spacing = 0.005 ", "spacing = 0.02 ")];
+    // The tank rolls, and a paddle moves on a sinusoid beside the floating box.
+    let edits = [
+        ("spacing = 0.005 ", "spacing = 0.02 "),
+        (
+            "max = [1.0, 0.6]\n",
+            "max = [1.0, 0.6]\n\n[container.trajectory]\npivot = [0.5, 0.0]\nperiod = 1.0\nangle = 3.0\n",
+        ),
+        (
+            "density = 500.0                 # [kg/m^3]: s = 0.5",
+            "density = 500.0\n\n[[body]]\nname = \"paddle\"\nshape = \"box\"\nmin = [0.06, 0.2]\nmax = [0.1, 0.4]\ndensity = 1000.0\nmotion = \"prescribed\"\n\n[body.trajectory]\nperiod = 0.5\namplitude = [0.02, 0.0]\nangle = 5.0\n",
+        ),
+    ];
     let file = scene_file(dir.path(), "floating_box_2d.toml", &edits, 0.1, 2);
     let scene = Scene::load(&file).unwrap();
     // Stopped while the box heaves: its state comes from the checkpoint, not the scene.

@@ -65,9 +65,10 @@ fn one_and_two_threads_write_bit_identical_frames() {
     assert_thread_count_independent("dam-break", &scene, 0.03, 3);
 }
 
-/// Bodies: their sums run in the sorted order on one thread.
+/// Bodies, free and prescribed, in a rolling tank: their sums run in the sorted order on one
+/// thread.
 #[test]
-fn a_floating_and_a_sinking_body_are_bit_identical_on_one_and_two_threads() {
+fn free_and_prescribed_bodies_in_a_rolling_tank_are_bit_identical_on_one_and_two_threads() {
     let mut scene = shipped_scene("floating_box_2d.toml");
     scene.spacing = 0.02;
     scene.output_interval = 0.05;
@@ -78,7 +79,29 @@ fn a_floating_and_a_sinking_body_are_bit_identical_on_one_and_two_threads() {
         radius: 0.06,
     };
     sinker.mass = isph::scene::BodyMass::Density(1500.0);
-    scene.bodies.push(sinker);
+    scene.bodies.push(sinker.clone());
+    // A paddle on a sinusoid, in a tank that rolls.
+    let mut paddle = sinker;
+    paddle.name = "paddle".into();
+    paddle.shape = isph::scene::Shape::Box {
+        min: vec![0.82, 0.2],
+        max: vec![0.88, 0.4],
+    };
+    let roll = |amplitude: [f64; 3], degrees: f64, period: f64, pivot: [f64; 3]| {
+        isph::scene::trajectory::Trajectory {
+            pivot,
+            axis: [0.0, 0.0, 1.0],
+            path: isph::scene::trajectory::Path::Sinusoid {
+                amplitude,
+                angle: degrees.to_radians(),
+                period,
+            },
+        }
+    };
+    paddle.motion =
+        isph::scene::BodyMotion::Prescribed(roll([0.02, 0.0, 0.0], 5.0, 0.5, [0.85, 0.3, 0.0]));
+    scene.bodies.push(paddle);
+    scene.container_motion = Some(roll([0.0; 3], 3.0, 1.0, [0.5, 0.0, 0.0]));
     assert_thread_count_independent("bodies", &scene, 0.2, 4);
 }
 

@@ -19,6 +19,7 @@ mod interface;
 mod kernel;
 mod krylov;
 mod layering;
+mod moving_container;
 mod neighbours;
 mod operators;
 mod output_readers;

@@ -48,6 +48,8 @@ pub struct Plan {
 pub struct PlannedBody {
     pub name: String,
     pub motion: BodyMotion,
+    /// The time a fixed or prescribed body is let go (None: never).
+    pub release: Option<f64>,
     pub particles: usize,
     /// Its mass [kg] (per metre of depth in 2D) and density [kg/m³].
     pub mass: f64,
@@ -97,6 +99,7 @@ impl Plan {
             .map(|(b, displaced)| PlannedBody {
                 name: b.name.clone(),
                 motion: b.motion.clone(),
+                release: b.release,
                 particles: b.offsets.len(),
                 mass: b.mass,
                 density: b.mass / (b.offsets.len() as f64 * volume),
@@ -203,7 +206,10 @@ impl fmt::Display for Plan {
                 match &b.motion {
                     BodyMotion::Prescribed(t) => format!("prescribed ({})", t.describe()),
                     m => m.name().to_string(),
-                },
+                } + &b
+                    .release
+                    .map(|t| format!(", released at {t} s"))
+                    .unwrap_or_default(),
                 b.particles,
                 b.mass,
                 b.density,

@@ -131,6 +131,9 @@ impl Validator<'_> {
                 "= \"{file}\" ends at {last:?} s, before `simulation.end_time` = {end_time:?} s: the table must cover the whole run"
             ),
         )?;
-        Ok(Path::Table { file: path, rows })
+        Ok(Path::Table {
+            file: file.into(),
+            rows,
+        })
     }
 }

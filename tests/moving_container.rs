@@ -1,0 +1,121 @@
+//! A moving container, solved in its frame (docs/bodies.md, "Moving containers"): a tank tilted
+//! slowly keeps its water level in the laboratory; the SPHERIC 10 sloshing tank's wall impacts
+//! come once per period as the experiment's do.
+
+use crate::common::{read_frame, run_scene, shipped_scene, TempDir};
+use isph::io::probes;
+use isph::Scene;
+
+/// The slope of the free surface in frame `frame`: a line through the top fluid particle of
+/// each column two spacings wide, 5 cm and more from the side walls of a tank `width` wide.
+fn surface_slope(out: &std::path::Path, frame: usize, spacing: f64, width: f64) -> f64 {
+    let kind: Vec<i32> = read_frame(out, frame, "kind");
+    let pos: Vec<f64> = read_frame(out, frame, "position");
+    let mut tops = std::collections::BTreeMap::new();
+    for i in (0..kind.len()).filter(|&i| kind[i] == 0) {
+        let top = tops
+            .entry((pos[3 * i] / (2.0 * spacing)).floor() as i64)
+            .or_insert(f64::MIN);
+        *top = pos[3 * i + 1].max(*top);
+    }
+    let points: Vec<(f64, f64)> = tops
+        .iter()
+        .map(|(c, y)| ((*c as f64 + 0.5) * 2.0 * spacing, *y))
+        .filter(|(x, _)| *x > 0.05 && *x < width - 0.05)
+        .collect();
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    sxy / sxx
+}
+
+#[test]
+fn a_tank_tilted_slowly_keeps_its_water_level_in_the_laboratory() {
+    // Tilted to 10° along a table (a half-cosine ramp over 2 s, then held): in the tank's frame
+    // the surface must slope at −tan 10°, the laboratory's level. The ramp leaves a slosh of
+    // the first mode (period 0.99 s); the mean over 3–4 s takes it out.
+    let dir = TempDir::new("moving-tilt");
+    let mut table = String::from("time,x,y,angle\n");
+    for k in -2..=40 {
+        let t = k as f64 * 0.05;
+        let ramp = 0.5 * (1.0 - (std::f64::consts::PI * t.clamp(0.0, 2.0) / 2.0).cos());
+        table += &format!("{t:?},0,0,{:?}\n", 10.0 * ramp);
+    }
+    table += "10.0,0,0,10.0\n";
+    std::fs::write(dir.path().join("tilt.csv"), table).unwrap();
+    let text = r#"[simulation]
+dimensions = 2
+spacing = 0.01
+end_time = 4.0
+output_interval = 0.05
+gravity = [0.0, -9.81]
+
+[[fluid]]
+name = "water"
+density = 1000.0
+viscosity = 1.0e-6
+
+[[fluid_block]]
+fluid = "water"
+min = [0.0, 0.0]
+max = [0.6, 0.2]
+
+[container]
+min = [0.0, 0.0]
+max = [0.6, 0.4]
+
+[container.trajectory]
+pivot = [0.3, 0.0]
+table = "tilt.csv"
+"#;
+    let path = dir.path().join("tilt.toml");
+    std::fs::write(&path, text).unwrap();
+    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let out = dir.path().join("out");
+    run_scene(&scene, &out, 4.0);
+    let slopes: Vec<f64> = (60..=80)
+        .map(|f| surface_slope(&out, f, 0.01, 0.6))
+        .collect();
+    let slope = slopes.iter().sum::<f64>() / slopes.len() as f64;
+    let expected = -(10f64.to_radians().tan());
+    eprintln!("slope {slope} against {expected}");
+    assert!(
+        (slope / expected - 1.0).abs() < 0.03,
+        "mean surface slope {slope} over 3–4 s against −tan 10° = {expected}"
+    );
+}
+
+#[test]
+fn the_spheric_10_tank_hits_its_wall_once_per_period_as_the_experiment_does() {
+    // The experiment's impact onsets (pressure above 1 kPa on the left-wall sensor) are 2.375,
+    // 4.050 and 5.672 s: 1.675 and 1.622 s apart. The scene's sinusoidal roll has not the
+    // experiment's recorded start, which shifts every onset alike (docs/bodies.md), so what is
+    // checked here is the interval between impacts, within the benchmark's 0.03 s.
+    let dir = TempDir::new("moving-spheric10");
+    let scene = shipped_scene("sloshing_spheric10_2d.toml");
+    run_scene(&scene, dir.path(), 5.8);
+    let (columns, rows) = probes::read(dir.path()).unwrap();
+    let sensor = columns.iter().position(|c| c == "sensor").unwrap();
+    let mut onsets: Vec<f64> = Vec::new();
+    for r in &rows {
+        let (t, p) = (r[0], r[sensor]);
+        if p > 1000.0 && onsets.last().is_none_or(|last| t > last + 0.8) {
+            onsets.push(t);
+        }
+    }
+    eprintln!("onsets {onsets:?}");
+    assert_eq!(onsets.len(), 3, "impact onsets {onsets:?}");
+    for (k, expected) in [1.675, 1.622].into_iter().enumerate() {
+        let interval = onsets[k + 1] - onsets[k];
+        assert!(
+            (interval - expected).abs() < 0.03,
+            "impacts {} and {} are {interval} s apart against the experiment's {expected}",
+            k + 1,
+            k + 2
+        );
+    }
+}
