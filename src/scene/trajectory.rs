@@ -33,7 +33,12 @@ pub enum Path {
     /// Hermite curve with finite-difference slopes (Catmull–Rom) through them, taken relative to
     /// its value at t = 0, so its velocity is continuous and its acceleration bounded. After
     /// the last row the pose stays the last row's, at rest.
-    Table { file: PathBuf, rows: Vec<TableRow> },
+    Table {
+        /// As the scene names it, relative to the scene file's folder (the scene's hash then
+        /// holds the rows, not where the scene was read from).
+        file: PathBuf,
+        rows: Vec<TableRow>,
+    },
 }
 
 /// One row of a motion table: time [s], displacement [m] (z = 0 in 2D) and angle [rad].
