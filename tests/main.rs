@@ -31,5 +31,6 @@ mod stability;
 mod study;
 mod surface;
 mod surface_runs;
+mod two_fluids;
 mod validation;
 mod wall_contact;
