@@ -368,6 +368,7 @@ fn each_bad_body_is_refused_with_its_key() {
         ("shape = \"circle\"\ncenter = [0.1, 0.1]\ndensity = 500.0", &["body[0].radius", "missing"]),
         ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\nmin = [0.0, 0.0]\ndensity = 500.0", &["body[0].min", "not a key of a circle"]),
         ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05", &["body[0]", "neither `density`"]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0\nfriction = -0.1", &["body[0].friction", "≥ 0"]),
     ];
     for (text, expected) in cases {
         let (code, stderr) = run_text(dir.path(), &body(text), &[]);

@@ -17,6 +17,8 @@
 //! is f64 and lasting (checkpointed); the particles' positions are set from it every step,
 //! never advected, so a body never changes shape.
 
+mod contact;
+
 use crate::math::aabb::Aabb;
 use crate::math::rotation::{self, cross, Mat3, Quaternion, Vec3};
 use crate::math::shape::Shape;
@@ -96,6 +98,8 @@ pub struct RigidBody {
     pub inertia: Mat3,
     pub external_force: Vec3,
     pub restitution: f64,
+    /// Coulomb friction coefficient of its contacts.
+    pub friction: f64,
     /// The body's particles are those with ids first_id .. first_id + offsets.len().
     pub first_id: u64,
     /// Each particle's offset from the centre of mass in the body's own frame, by id − first_id.
@@ -168,6 +172,17 @@ impl RigidBody {
         rotation::apply(&r, rotation::apply(&inverse, body_l))
     }
 
+    /// Signed distance of the world point x from the body's surface (negative inside), in a
+    /// `dims`-dimensional scene.
+    pub fn surface_distance(&self, x: &Vec3, dims: usize) -> f64 {
+        let arm: Vec3 = std::array::from_fn(|d| x[d] - self.state.centre[d]);
+        let local = rotation::apply_transposed(&self.rotation(), arm);
+        let at_start: Vec<f64> = (0..dims)
+            .map(|d| self.centre_at_start[d] + local[d])
+            .collect();
+        self.shape.signed_distance(&at_start)
+    }
+
     /// Offset of particle `id` from the centre, in the world frame, for rotation `r`.
     pub fn arm(&self, r: &Mat3, id: u64) -> Vec3 {
         rotation::apply(r, self.offsets[(id - self.first_id) as usize])
@@ -192,7 +207,10 @@ pub struct Bodies {
     /// The container's faces a body's particles keep half a spacing off, per axis (None along
     /// a periodic axis).
     faces: Vec<Option<(f64, f64)>>,
+    /// The obstacles, which bodies touch as they touch each other.
+    obstacles: Vec<Shape>,
     spacing: f64,
+    dims: usize,
 }
 
 impl Bodies {
@@ -257,6 +275,7 @@ impl Bodies {
                         body.force.get(d).copied().unwrap_or(0.0)
                     }),
                     restitution: body.restitution,
+                    friction: body.friction,
                     first_id,
                     offsets,
                     state: RigidState {
@@ -291,7 +310,16 @@ impl Bodies {
             faces: (0..D)
                 .map(|d| (!scene.periodic[d]).then_some((c.min[d], c.max[d])))
                 .collect(),
+            obstacles: scene
+                .obstacles
+                .iter()
+                .map(|o| Shape::Box {
+                    min: o.min.clone(),
+                    max: o.max.clone(),
+                })
+                .collect(),
             spacing: scene.spacing,
+            dims: D,
         }
     }
 
@@ -333,8 +361,9 @@ impl Bodies {
     /// Advances body b's state over the step from `time` to `time + dt` from the momentum
     /// `impulse` and angular momentum `angular_impulse` the step's fluid stages gave its particles
     /// beyond their rigid motion, `applied` and `applied_torque` of them the body forces' (the
-    /// sums of m_i f_i and r_ic × m_i f_i, `ghosts::BodyForce`); a free body is then kept off the
-    /// container's faces (`keep_inside`), a fixed or prescribed one put where its motion says.
+    /// sums of m_i f_i and r_ic × m_i f_i, `ghosts::BodyForce`); a fixed or prescribed one is
+    /// put where its motion says. The contacts are resolved after every body has moved
+    /// (`resolve_contacts`).
     pub fn advance(
         &mut self,
         b: usize,
@@ -344,7 +373,6 @@ impl Bodies {
         time: f64,
         dt: f64,
     ) {
-        let (faces, spacing) = (&self.faces, self.spacing);
         let body = &mut self.bodies[b];
         let s = body.state;
         let (force, torque) = (
@@ -384,7 +412,6 @@ impl Bodies {
             .then_after(s.orientation)
             .normalised();
         body.state.centre = centre;
-        keep_inside(body, faces, spacing);
     }
 }
 
@@ -402,42 +429,23 @@ impl Bodies {
             if arm.iter().map(|a| a * a).sum::<f64>() > (body.reach + gap).powi(2) {
                 continue;
             }
-            let r = body.rotation();
-            let local = rotation::apply_transposed(&r, arm);
-            let at_start = |l: Vec3| -> Vec<f64> {
-                (0..dims).map(|d| body.centre_at_start[d] + l[d]).collect()
-            };
-            let distance = body.shape.signed_distance(&at_start(local));
+            let surface = |y: &Vec3| body.surface_distance(y, dims);
+            let distance = surface(x);
             if distance >= gap {
                 continue;
             }
-            // The outward normal: the gradient of the signed distance, by central differences.
-            let eps = 1e-3 * gap;
-            let gradient: Vec3 = std::array::from_fn(|d| {
-                if d >= dims {
-                    return 0.0;
-                }
-                let (mut plus, mut minus) = (local, local);
-                plus[d] += eps;
-                minus[d] -= eps;
-                (body.shape.signed_distance(&at_start(plus))
-                    - body.shape.signed_distance(&at_start(minus)))
-                    / (2.0 * eps)
-            });
-            let length = dot3(gradient, gradient).sqrt();
-            if length == 0.0 {
+            let Some(normal) = outward_normal(&surface, *x, gap, dims) else {
                 continue;
-            }
-            let normal = rotation::apply(&r, gradient.map(|g| g / length));
+            };
             for d in 0..dims {
                 x[d] += (gap - distance) * normal[d];
             }
-            let surface = rigid_velocity(
+            let wall = rigid_velocity(
                 s.velocity,
                 body.angular_velocity(),
                 std::array::from_fn(|d| x[d] - s.centre[d]),
             );
-            let into: f64 = (0..dims).map(|d| (u[d] - surface[d]) * normal[d]).sum();
+            let into: f64 = (0..dims).map(|d| (u[d] - wall[d]) * normal[d]).sum();
             if into < 0.0 {
                 for d in 0..dims {
                     u[d] -= into * normal[d];
@@ -447,41 +455,6 @@ impl Bodies {
             crossed = crossed || distance < 0.0;
         }
         (moved, crossed)
-    }
-}
-
-/// The contact of a body with the container: each of its particles stays half a spacing
-/// inside every face (where the lattice puts the first fluid and body particles at t = 0). A
-/// body that would cross a face is moved back along its normal by its deepest particle's
-/// penetration, and its velocity into the face becomes −e times itself (e the restitution).
-/// The wall ghosts' pressure holds a body off a face as it does the fluid; this catches what
-/// comes through, deterministically, as `Faces::contact` does for fluid particles.
-fn keep_inside(body: &mut RigidBody, faces: &[Option<(f64, f64)>], spacing: f64) {
-    let r = body.rotation();
-    let arms: Vec<Vec3> = body
-        .offsets
-        .iter()
-        .map(|o| rotation::apply(&r, *o))
-        .collect();
-    let gap = 0.5 * spacing;
-    for (d, face) in faces.iter().enumerate() {
-        let Some((lo, hi)) = *face else { continue };
-        let lowest = arms.iter().map(|a| a[d]).fold(f64::INFINITY, f64::min);
-        let highest = arms.iter().map(|a| a[d]).fold(f64::NEG_INFINITY, f64::max);
-        let s = &mut body.state;
-        let below = lo + gap - (s.centre[d] + lowest);
-        let above = s.centre[d] + highest - (hi - gap);
-        if below > 0.0 {
-            s.centre[d] += below;
-            if s.velocity[d] < 0.0 {
-                s.velocity[d] *= -body.restitution;
-            }
-        } else if above > 0.0 {
-            s.centre[d] -= above;
-            if s.velocity[d] > 0.0 {
-                s.velocity[d] *= -body.restitution;
-            }
-        }
     }
 }
 
@@ -504,6 +477,28 @@ fn inertia_tensor(offsets: &[Vec3], masses: &[f64], dims: usize) -> Mat3 {
         inertia[2][2] = zz;
     }
     inertia
+}
+
+/// The outward unit normal at x of the surface whose signed distance is `distance`: its
+/// gradient by central differences a thousandth of `scale` wide (None where it vanishes).
+pub(crate) fn outward_normal(
+    distance: &dyn Fn(&Vec3) -> f64,
+    x: Vec3,
+    scale: f64,
+    dims: usize,
+) -> Option<Vec3> {
+    let eps = 1e-3 * scale;
+    let gradient: Vec3 = std::array::from_fn(|d| {
+        if d >= dims {
+            return 0.0;
+        }
+        let (mut plus, mut minus) = (x, x);
+        plus[d] += eps;
+        minus[d] -= eps;
+        (distance(&plus) - distance(&minus)) / (2.0 * eps)
+    });
+    let length = dot3(gradient, gradient).sqrt();
+    (length > 0.0).then(|| gradient.map(|g| g / length))
 }
 
 /// The rigid velocity V + ω × r of a point at arm r.

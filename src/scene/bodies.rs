@@ -50,6 +50,8 @@ pub struct Body {
     pub force: Vec<f64>,
     /// The ratio of the speed off a wall to the speed into it in a contact (0: the body stops).
     pub restitution: f64,
+    /// The Coulomb friction coefficient of its contacts (0: frictionless).
+    pub friction: f64,
     /// The velocity of its centre of mass at t = 0 [m/s].
     pub velocity: Vec<f64>,
     /// Its angular velocity at t = 0 [rad/s]: 3 components in 3D, 1 (about z) in 2D.

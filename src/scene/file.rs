@@ -50,6 +50,7 @@ pub(super) struct BodySection {
     pub(super) motion: Option<String>,
     pub(super) force: Option<Vec<f64>>,
     pub(super) restitution: Option<f64>,
+    pub(super) friction: Option<f64>,
     pub(super) velocity: Option<Vec<f64>>,
     pub(super) angular_velocity: Option<Vec<f64>>,
     pub(super) trajectory: Option<TrajectorySection>,

@@ -72,11 +72,11 @@ impl RigidBodies {
                 applied[b][0][d] += mf[d];
                 applied[b][1][d] += mf_t[d];
             }
-            touched[b] = touched[b] || touches_another(nb, p, i);
+            touched[b] = touched[b] || touches_fluid_or_wall(nb, p, i);
         }
         for b in 0..count {
             if !touched[b] {
-                // Nothing but the body in reach of its particles: in the air it feels its body
+                // No fluid or wall in reach of its particles: in the air it feels its body
                 // forces alone (gravity and its external force), whatever the pressure solve
                 // left inside it (its rows are solved to the tolerance only); free fall is then
                 // exact to round-off.
@@ -85,6 +85,7 @@ impl RigidBodies {
             }
             bodies.advance(b, impulse[b], angular[b], applied[b], time, dt);
         }
+        bodies.resolve_contacts(time);
         let poses: Vec<_> = bodies
             .bodies
             .iter()
@@ -137,11 +138,13 @@ impl RigidBodies {
     }
 }
 
-/// Whether a particle of another body, of the fluid or of a wall is in reach of body particle i.
-fn touches_another<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> bool {
+/// Whether a particle of the fluid or of a wall is in reach of body particle i. Another body's
+/// particles do not count: two bodies that meet in the air touch through their contact
+/// (`Bodies::resolve_contacts`), not through the pressure the solve puts between them.
+fn touches_fluid_or_wall<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> bool {
     let mut touches = false;
     nb.for_each(i, |j, _, _| {
-        touches = touches || p.kind[j] != Kind::Body || p.fluid[j] != p.fluid[i];
+        touches = touches || p.kind[j] != Kind::Body;
     });
     touches
 }

@@ -736,6 +736,12 @@ impl Validator<'_> {
                 &format!("{key}.restitution"),
                 format!("= {restitution:?} must lie in [0, 1]"),
             )?;
+            let friction = b.friction.unwrap_or(0.0);
+            self.check(
+                friction.is_finite() && friction >= 0.0,
+                &format!("{key}.friction"),
+                format!("= {friction:?} must be a coefficient ≥ 0"),
+            )?;
             let velocity = b.velocity.clone().unwrap_or(vec![0.0; dims]);
             self.vector(&velocity, dims, &format!("{key}.velocity"))?;
             let turns = if dims == 2 { 1 } else { 3 };
@@ -777,6 +783,7 @@ impl Validator<'_> {
                 release: b.release,
                 force,
                 restitution,
+                friction,
                 velocity,
                 angular_velocity,
             });
