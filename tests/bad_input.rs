@@ -408,3 +408,29 @@ fn each_bad_trajectory_is_refused_with_its_key() {
         assert_refused(code, &stderr, expected);
     }
 }
+
+#[test]
+fn each_bad_mesh_is_refused_with_its_key() {
+    let dir = TempDir::new("bad-meshes");
+    // A cube with its top face missing: open.
+    std::fs::write(
+        dir.path().join("open.obj"),
+        "v 0.1 0.1 0.1\nv 0.2 0.1 0.1\nv 0.1 0.2 0.1\nv 0.2 0.2 0.1\nv 0.1 0.1 0.2\nv 0.2 0.1 0.2\nv 0.1 0.2 0.2\nv 0.2 0.2 0.2\nf 1 3 4 2\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("bad.obj"), "v 0.1 0.1\nf 1 2 3\n").unwrap();
+    let scene = |body: &str| {
+        crate::common::water_block_scene_3d([0.2, 0.2, 0.1], [0.4, 0.4, 0.4], 0.01, 0.01, body)
+    };
+    let cases: &[(&str, &[&str])] = &[
+        ("[[body]]\nshape = \"mesh\"\nmesh = \"missing.obj\"\ndensity = 500.0", &["body[0].mesh", "cannot read"]),
+        ("[[body]]\nshape = \"mesh\"\nmesh = \"open.obj\"\ndensity = 500.0", &["body[0].mesh", "not closed", "4 of its edges"]),
+        ("[[body]]\nshape = \"mesh\"\nmesh = \"bad.obj\"\ndensity = 500.0", &["body[0].mesh", "line 1", "three finite numbers"]),
+        ("[[body]]\nshape = \"box\"\nmin = [0.1, 0.1, 0.2]\nmax = [0.2, 0.2, 0.3]\noffset = [0.0, 0.0, 0.0]\ndensity = 500.0", &["body[0].offset", "moves a mesh"]),
+        ("[[fluid_block]]\nfluid = \"water\"\nmin = [0.0, 0.0, 0.2]\nmax = [0.1, 0.1, 0.3]\nmesh = \"open.obj\"", &["fluid_block[1]", "not both"]),
+    ];
+    for (text, expected) in cases {
+        let (code, stderr) = run_text(dir.path(), &scene(text), &[]);
+        assert_refused(code, &stderr, expected);
+    }
+}

@@ -699,3 +699,116 @@ fn circle_centre(rows: &[(f64, Vec<f64>)], k: usize, start: [f64; 2]) -> (f64, f
         now[Y] + sin * offset[0] + cos * offset[1],
     )
 }
+
+/// A UV sphere of `radius` about `centre` as an ASCII STL: `rings` × 2 `rings` quads, the caps
+/// fans, faces wound outwards.
+fn sphere_stl(centre: [f64; 3], radius: f64, rings: usize) -> String {
+    let point = |i: usize, j: usize| -> [f64; 3] {
+        // The seam and the poles exactly shared: an STL's facets join at equal vertices.
+        let j = j % (2 * rings);
+        if i == 0 || i == rings {
+            let sign = if i == 0 { 1.0 } else { -1.0 };
+            return [centre[0], centre[1], centre[2] + sign * radius];
+        }
+        let (theta, phi) = (
+            std::f64::consts::PI * i as f64 / rings as f64,
+            std::f64::consts::PI * j as f64 / rings as f64,
+        );
+        [
+            centre[0] + radius * theta.sin() * phi.cos(),
+            centre[1] + radius * theta.sin() * phi.sin(),
+            centre[2] + radius * theta.cos(),
+        ]
+    };
+    let mut text = String::from("solid sphere\n");
+    let mut facet = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+        text += "facet normal 0 0 0\nouter loop\n";
+        for v in [a, b, c] {
+            text += &format!("vertex {:?} {:?} {:?}\n", v[0], v[1], v[2]);
+        }
+        text += "endloop\nendfacet\n";
+    };
+    for i in 0..rings {
+        for j in 0..2 * rings {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            if i > 0 {
+                facet(a, b, d);
+            }
+            if i + 1 < rings {
+                facet(b, c, d);
+            }
+        }
+    }
+    text + "endsolid sphere\n"
+}
+
+#[test]
+fn a_closed_mesh_fills_a_body_or_a_fluid_block_with_its_volume() {
+    // A sphere 30 spacings across as a triangle mesh (an STL of 1024 facets, the poles' rows
+    // merged): its particles fill N dx³ within 2% of the mesh's own volume (VALIDATION.md,
+    // "Mesh filling"), and each lies inside the mesh by the winding number.
+    let dir = TempDir::new("bodies-mesh");
+    let rings = 16;
+    std::fs::write(
+        dir.path().join("sphere.stl"),
+        sphere_stl([0.0; 3], 0.15, rings),
+    )
+    .unwrap();
+    let body = "[[body]]\nshape = \"mesh\"\nmesh = \"sphere.stl\"\noffset = [0.3, 0.3, 0.4]\ndensity = 500.0\n";
+    let text = tank(3, 0.01, [0.6, 0.6, 0.6], 0.1, 0.05, body);
+    let path = dir.path().join("mesh.toml");
+    std::fs::write(&path, text).unwrap();
+    let scene = isph::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let isph::scene::Shape::Mesh(mesh) = &scene.bodies[0].shape else {
+        panic!("not a mesh")
+    };
+    let particles = isph::fill::build::<3>(&scene);
+    let count = particles
+        .kind
+        .iter()
+        .filter(|k| **k == isph::particles::Kind::Body)
+        .count();
+    let volume = count as f64 * 1e-6;
+    let error = volume / mesh.volume() - 1.0;
+    eprintln!(
+        "{count} particles: {volume} m³ against the mesh's {} ({:+.2}%)",
+        mesh.volume(),
+        100.0 * error
+    );
+    assert!(
+        error.abs() < 0.02,
+        "particle volume {volume} against {}",
+        mesh.volume()
+    );
+    // The box test of the same cube as a mesh fills the same lattice points as a box.
+    let cube = "v 0.2 0.2 0.3\nv 0.4 0.2 0.3\nv 0.2 0.4 0.3\nv 0.4 0.4 0.3\nv 0.2 0.2 0.45\nv 0.4 0.2 0.45\nv 0.2 0.4 0.45\nv 0.4 0.4 0.45\nf 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+    std::fs::write(dir.path().join("cube.obj"), cube).unwrap();
+    let count_of = |body: &str| {
+        let path = dir.path().join("cube.toml");
+        std::fs::write(&path, tank(3, 0.01, [0.6, 0.6, 0.6], 0.1, 0.05, body)).unwrap();
+        let scene = isph::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        isph::fill::build::<3>(&scene)
+            .kind
+            .iter()
+            .filter(|k| **k == isph::particles::Kind::Body)
+            .count()
+    };
+    let as_mesh = count_of("[[body]]\nshape = \"mesh\"\nmesh = \"cube.obj\"\ndensity = 500.0\n");
+    let as_box = count_of("[[body]]\nshape = \"box\"\nmin = [0.2, 0.2, 0.3]\nmax = [0.4, 0.4, 0.45]\ndensity = 500.0\n");
+    assert_eq!(as_mesh, as_box);
+    // A fluid block from the sphere's mesh (a ball of water in the air) holds the same lattice
+    // points as the body did.
+    let ball =
+        "[[fluid_block]]\nfluid = \"water\"\nmesh = \"sphere.stl\"\noffset = [0.3, 0.3, 0.4]\n";
+    let path = dir.path().join("ball.toml");
+    std::fs::write(&path, tank(3, 0.01, [0.6, 0.6, 0.6], 0.1, 0.05, ball)).unwrap();
+    let scene = isph::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let water = isph::fill::build::<3>(&scene).fluid_count();
+    let floor = 60 * 60 * 10;
+    assert_eq!(water - floor, count, "a ball of water from the mesh");
+}

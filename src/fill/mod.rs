@@ -109,10 +109,7 @@ pub fn displaced_by_bodies<const D: usize>(scene: &Scene) -> Vec<usize> {
         if block_of(scene, &x).is_none() || near_obstacle(scene, &x) {
             return;
         }
-        let first = scene
-            .bodies
-            .iter()
-            .position(|b| b.shape.signed_distance(&x) < margin);
+        let first = scene.bodies.iter().position(|b| b.shape.near(&x, margin));
         if let Some(b) = first {
             displaced[b] += 1;
         }
@@ -124,10 +121,7 @@ pub fn displaced_by_bodies<const D: usize>(scene: &Scene) -> Vec<usize> {
 /// starts there (as at an obstacle, `near_obstacle`).
 fn near_body<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
     let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
-    scene
-        .bodies
-        .iter()
-        .any(|b| b.shape.signed_distance(x) < margin)
+    scene.bodies.iter().any(|b| b.shape.near(x, margin))
 }
 
 /// The block lattice point x belongs to: the first that holds it strictly inside. A point on
@@ -138,7 +132,7 @@ fn near_body<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
 /// keeps its points out, as half their cell lies outside.
 fn block_of<'a, const D: usize>(scene: &'a Scene, x: &[f64; D]) -> Option<&'a Block> {
     let blocks = &scene.blocks;
-    if let Some(b) = blocks.iter().find(|b| b.region.contains(x)) {
+    if let Some(b) = blocks.iter().find(|b| b.contains(x)) {
         return Some(b);
     }
     let on_face = blocks
@@ -154,7 +148,7 @@ fn block_of<'a, const D: usize>(scene: &'a Scene, x: &[f64; D]) -> Option<&'a Bl
                     -quarter
                 }
             });
-            blocks.iter().any(|b| b.region.contains(&probe))
+            blocks.iter().any(|b| b.contains(&probe))
         })
         .count();
     (2 * covered > 1 << D).then_some(on_face)

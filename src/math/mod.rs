@@ -7,6 +7,7 @@ pub mod kernel;
 pub mod lanes;
 pub(crate) mod lattice;
 pub mod memory;
+pub mod mesh;
 pub mod reduce;
 pub mod rotation;
 pub mod shape;

@@ -3,6 +3,7 @@
 //! outside keeps fluid half a spacing off it at the start.
 
 use super::aabb::Aabb;
+use super::mesh::TriangleMesh;
 
 /// A body's shape where it starts, in world coordinates.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,6 +20,8 @@ pub enum Shape {
         axis: usize,
         length: f64,
     },
+    /// A closed triangle mesh (3D), inside by its winding number (`mesh`).
+    Mesh(TriangleMesh),
 }
 
 impl Shape {
@@ -29,6 +32,7 @@ impl Shape {
             Shape::Ball { .. } if dims == 2 => "circle",
             Shape::Ball { .. } => "sphere",
             Shape::Cylinder { .. } => "cylinder",
+            Shape::Mesh(_) => "mesh",
         }
     }
 
@@ -57,12 +61,23 @@ impl Shape {
                 let along = (x[*axis] - center[*axis]).abs() - 0.5 * length;
                 slab_distance(&[radial, along])
             }
+            Shape::Mesh(mesh) => mesh.signed_distance(x),
         }
+    }
+
+    /// Whether x lies inside or less than `margin` outside (a box test first: a mesh's
+    /// distance visits every triangle).
+    pub fn near(&self, x: &[f64], margin: f64) -> bool {
+        self.bounds().contains_within(x, margin) && self.signed_distance(x) < margin
     }
 
     /// Whether x lies inside.
     pub fn contains(&self, x: &[f64]) -> bool {
-        self.signed_distance(x) < 0.0
+        match self {
+            // The winding number alone: no distance to find.
+            Shape::Mesh(mesh) => mesh.contains(x),
+            _ => self.signed_distance(x) < 0.0,
+        }
     }
 
     /// The smallest axis-aligned box around the shape.
@@ -88,6 +103,7 @@ impl Shape {
                     max: (0..center.len()).map(|d| center[d] + half(d)).collect(),
                 }
             }
+            Shape::Mesh(mesh) => mesh.bounds().clone(),
         }
     }
 }

@@ -45,6 +45,8 @@ pub(super) struct BodySection {
     pub(super) radius: Option<f64>,
     pub(super) axis: Option<String>,
     pub(super) length: Option<f64>,
+    pub(super) mesh: Option<String>,
+    pub(super) offset: Option<Vec<f64>>,
     pub(super) density: Option<f64>,
     pub(super) mass: Option<f64>,
     pub(super) motion: Option<String>,
@@ -114,8 +116,10 @@ pub(super) struct SimulationSection {
 #[serde(deny_unknown_fields)]
 pub(super) struct FluidBlock {
     pub(super) fluid: String,
-    pub(super) min: Vec<f64>,
-    pub(super) max: Vec<f64>,
+    pub(super) min: Option<Vec<f64>>,
+    pub(super) max: Option<Vec<f64>>,
+    pub(super) mesh: Option<String>,
+    pub(super) offset: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

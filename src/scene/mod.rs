@@ -4,6 +4,7 @@
 mod bodies;
 mod effects;
 mod file;
+mod mesh_file;
 mod probes;
 mod surface;
 pub mod trajectory;
@@ -16,6 +17,7 @@ pub use surface::{CubeRule, SurfaceKernel, SurfaceRequest, SurfaceSettings};
 
 pub use crate::math::aabb::Aabb;
 use crate::math::kernel::SUPPORT_IN_H;
+use crate::math::mesh::TriangleMesh;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -144,7 +146,17 @@ impl Default for CheckpointSettings {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Block {
     pub fluid: usize,
+    /// The box it fills; a mesh block's the box around its mesh.
     pub region: Aabb,
+    /// The closed mesh it fills instead of the whole box (3D), if any.
+    pub mesh: Option<TriangleMesh>,
+}
+
+impl Block {
+    /// Whether x lies strictly inside its box and, for a mesh block, inside the mesh.
+    pub fn contains(&self, x: &[f64]) -> bool {
+        self.region.contains(x) && self.mesh.as_ref().is_none_or(|m| m.contains(x))
+    }
 }
 
 /// A validated scene.

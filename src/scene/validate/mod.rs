@@ -3,6 +3,9 @@
 
 mod trajectory;
 
+use super::mesh_file;
+use crate::math::mesh::TriangleMesh;
+
 use super::file::{
     BodySection, BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection,
     ProbeSection, SceneFile, ShiftingSection, SimulationSection, SurfaceSection,
@@ -211,13 +214,51 @@ impl Validator<'_> {
                         ),
                     )
                 })?;
-            let section = BoxSection {
-                min: b.min.clone(),
-                max: b.max.clone(),
+            let block = match (&b.mesh, &b.min, &b.max) {
+                (None, Some(min), Some(max)) => {
+                    self.check(
+                        b.offset.is_none(),
+                        &format!("{key}.offset"),
+                        "is for a block from a `mesh`",
+                    )?;
+                    let section = BoxSection {
+                        min: min.clone(),
+                        max: max.clone(),
+                    };
+                    let region =
+                        self.region_inside(&section, &container, dims, &key, s.spacing, "block")?;
+                    Block {
+                        fluid,
+                        region,
+                        mesh: None,
+                    }
+                }
+                (Some(file), None, None) => {
+                    self.check(dims == 3, &format!("{key}.mesh"), "is for 3D scenes")?;
+                    let mesh = self.mesh(file, b.offset.as_ref(), &key, s.spacing)?;
+                    let region = mesh.bounds().clone();
+                    self.check(
+                        region.within(&container),
+                        &format!("{key}.mesh"),
+                        format!(
+                            "= \"{file}\" spans {:?} .. {:?}, which is not inside the container {:?} .. {:?}",
+                            region.min, region.max, container.min, container.max
+                        ),
+                    )?;
+                    Block {
+                        fluid,
+                        region,
+                        mesh: Some(mesh),
+                    }
+                }
+                _ => {
+                    return Err(self.error(
+                        &key,
+                        "needs either `min` and `max` (a box) or `mesh` (a closed triangle mesh), not both",
+                    ))
+                }
             };
-            let region =
-                self.region_inside(&section, &container, dims, &key, s.spacing, "block")?;
-            blocks.push(Block { fluid, region });
+            blocks.push(block);
         }
         let mut obstacles = Vec::new();
         for (k, o) in f.obstacle.iter().enumerate() {
@@ -848,7 +889,7 @@ impl Validator<'_> {
         let shapes: &[&str] = if dims == 2 {
             &["box", "circle"]
         } else {
-            &["box", "sphere", "cylinder"]
+            &["box", "sphere", "cylinder", "mesh"]
         };
         self.check(
             shapes.contains(&b.shape.as_str()),
@@ -870,12 +911,19 @@ impl Validator<'_> {
             ("radius", b.radius.is_some()),
             ("axis", b.axis.is_some()),
             ("length", b.length.is_some()),
+            ("mesh", b.mesh.is_some()),
         ];
         let needs: &[&str] = match b.shape.as_str() {
             "box" => &["min", "max"],
             "cylinder" => &["center", "radius", "axis", "length"],
+            "mesh" => &["mesh"],
             _ => &["center", "radius"],
         };
+        self.check(
+            b.offset.is_none() || b.shape == "mesh",
+            &format!("{key}.offset"),
+            format!("is not a key of a {}: it moves a mesh", b.shape),
+        )?;
         for (name, present) in given {
             let needed = needs.contains(&name);
             self.check(
@@ -932,11 +980,52 @@ impl Validator<'_> {
                     length: positive(b.length, "length")?,
                 }
             }
+            "mesh" => Shape::Mesh(self.mesh(
+                b.mesh.as_deref().unwrap_or_default(),
+                b.offset.as_ref(),
+                key,
+                spacing,
+            )?),
             _ => Shape::Ball {
                 center: vector(&b.center, "center")?,
                 radius: positive(b.radius, "radius")?,
             },
         })
+    }
+
+    /// The mesh of section `key` (a `shape = "mesh"` body, a fluid block): its `file` (relative
+    /// to the scene file's folder) read, closed, moved by `offset`.
+    fn mesh(
+        &self,
+        file: &str,
+        offset: Option<&Vec<f64>>,
+        key: &str,
+        spacing: f64,
+    ) -> Result<TriangleMesh, SceneError> {
+        let mesh_key = format!("{key}.mesh");
+        let path = self.path.parent().unwrap_or(Path::new(".")).join(file);
+        let mesh = mesh_file::read(&path).map_err(|message| {
+            self.error(
+                &mesh_key,
+                format!("= \"{file}\": {} {message}", path.display()),
+            )
+        })?;
+        let open = mesh.open_edges();
+        self.check(
+            open == 0,
+            &mesh_key,
+            format!("= \"{file}\" is not closed: {open} of its edges do not join exactly two triangles (a body's inside must be bounded)"),
+        )?;
+        let offset = offset.cloned().unwrap_or(vec![0.0; 3]);
+        self.vector(&offset, 3, &format!("{key}.offset"))?;
+        let mesh = mesh.moved(&offset);
+        let bounds = mesh.bounds();
+        self.check(
+            (0..3).all(|d| bounds.max[d] - bounds.min[d] >= spacing),
+            &mesh_key,
+            format!("= \"{file}\" spans {:?} .. {:?}: less than a spacing in some axis (are its units metres?)", bounds.min, bounds.max),
+        )?;
+        Ok(mesh)
     }
 
     fn checkpoint(&self, c: &CheckpointSection) -> Result<CheckpointSettings, SceneError> {
