@@ -279,7 +279,9 @@ friction = 0.5
         );
     }
     let drift = rows[*late.last().unwrap()].1[0] - rows[late[0]].1[0];
-    assert!(drift.abs() < 0.001, "it slid {drift} m in 0.5 s");
+    // Frictionless, it slides off at a few cm/s; held, it creeps as it rocks (measured 0.3 and
+    // 1.6 mm in 0.5 s in two builds whose rounding differed).
+    assert!(drift.abs() < 0.0025, "it slid {drift} m in 0.5 s");
     // No fluid particle ever inside the body.
     for frame in 0..rows.len() {
         let centre = [rows[frame].1[0], rows[frame].1[Y]];
@@ -624,7 +626,7 @@ friction = 0.5
 }
 
 #[test]
-fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_none_passes_through_another() {
+fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_nothing_passes_through_them() {
     // scenes/dam_break_solids_2d.toml at twice its spacing (D/dx = 5), to 3 s: four discs at
     // s = 1.5 and four at s = 0.8 in the surge.
     let dir = TempDir::new("bodies-solids");
@@ -646,7 +648,21 @@ fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_none_passes_throug
         // the floor (the contact's rule); allowed a quarter, for a pile that four passes leave
         // unresolved.
         let body: Vec<i32> = read_frame(dir.path(), k, "body");
+        let kind: Vec<i32> = read_frame(dir.path(), k, "kind");
         let pos: Vec<f64> = read_frame(dir.path(), k, "position");
+        // No fluid particle inside a disc.
+        for b in 0..8 {
+            let centre = circle_centre(&discs[b], k, circles[b]);
+            let inside = (0..kind.len())
+                .filter(|&i| kind[i] == 0)
+                .filter(|&i| (pos[3 * i] - centre.0).hypot(pos[3 * i + 1] - centre.1) < radius)
+                .count();
+            assert_eq!(
+                inside, 0,
+                "t = {}: {inside} fluid particles inside disc {b}",
+                row.0
+            );
+        }
         let lowest = (0..body.len())
             .filter(|&i| body[i] >= 0)
             .map(|i| pos[3 * i + 1])

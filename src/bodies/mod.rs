@@ -36,8 +36,9 @@ pub struct RigidState {
     pub velocity: Vec3,
     /// Angular momentum about the centre of mass, world frame [kg m²/s].
     pub angular_momentum: Vec3,
-    /// The fluid's force [N] and torque [N m] on the body over the last step (pressure,
-    /// viscosity and the walls' contact, without gravity and the external force).
+    /// The fluid's force [N] and torque [N m] on the body over the last step (pressure, the
+    /// walls' ghost pressure included, and viscosity; without gravity, the external force and
+    /// the contacts' impulses).
     pub force: Vec3,
     pub torque: Vec3,
 }
@@ -423,36 +424,45 @@ impl Bodies {
     /// had crossed the surface (a penetration).
     pub fn keep_out(&self, x: &mut Vec3, u: &mut Vec3, gap: f64, dims: usize) -> (bool, bool) {
         let (mut moved, mut crossed) = (false, false);
-        for body in &self.bodies {
-            let s = &body.state;
-            let arm: Vec3 = std::array::from_fn(|d| x[d] - s.centre[d]);
-            if arm.iter().map(|a| a * a).sum::<f64>() > (body.reach + gap).powi(2) {
-                continue;
-            }
-            let surface = |y: &Vec3| body.surface_distance(y, dims);
-            let distance = surface(x);
-            if distance >= gap {
-                continue;
-            }
-            let Some(normal) = outward_normal(&surface, *x, gap, dims) else {
-                continue;
-            };
-            for d in 0..dims {
-                x[d] += (gap - distance) * normal[d];
-            }
-            let wall = rigid_velocity(
-                s.velocity,
-                body.angular_velocity(),
-                std::array::from_fn(|d| x[d] - s.centre[d]),
-            );
-            let into: f64 = (0..dims).map(|d| (u[d] - wall[d]) * normal[d]).sum();
-            if into < 0.0 {
-                for d in 0..dims {
-                    u[d] -= into * normal[d];
+        // A second and third round for a particle put back off one body into another beside
+        // it (two bodies in contact); one squeezed between them stays where the last put it.
+        for _ in 0..3 {
+            let mut again = false;
+            for body in &self.bodies {
+                let s = &body.state;
+                let arm: Vec3 = std::array::from_fn(|d| x[d] - s.centre[d]);
+                if arm.iter().map(|a| a * a).sum::<f64>() > (body.reach + gap).powi(2) {
+                    continue;
                 }
+                let surface = |y: &Vec3| body.surface_distance(y, dims);
+                let distance = surface(x);
+                if distance >= gap {
+                    continue;
+                }
+                let Some(normal) = outward_normal(&surface, *x, gap, dims) else {
+                    continue;
+                };
+                for d in 0..dims {
+                    x[d] += (gap - distance) * normal[d];
+                }
+                let wall = rigid_velocity(
+                    s.velocity,
+                    body.angular_velocity(),
+                    std::array::from_fn(|d| x[d] - s.centre[d]),
+                );
+                let into: f64 = (0..dims).map(|d| (u[d] - wall[d]) * normal[d]).sum();
+                if into < 0.0 {
+                    for d in 0..dims {
+                        u[d] -= into * normal[d];
+                    }
+                }
+                moved = true;
+                again = true;
+                crossed = crossed || distance < 0.0;
             }
-            moved = true;
-            crossed = crossed || distance < 0.0;
+            if !again {
+                break;
+            }
         }
         (moved, crossed)
     }

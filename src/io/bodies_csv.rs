@@ -1,8 +1,8 @@
 //! `bodies.csv`: one row per body at every frame, `time,body,name,x,y,z,qw,qx,qy,qz,vx,vy,vz,
 //! wx,wy,wz,fx,fy,fz,tx,ty,tz`: the centre of mass, the orientation quaternion, the velocity of
 //! the centre, the angular velocity, and the fluid's force and torque on the body over the last
-//! step (pressure, viscosity and wall contact; not gravity nor the body's external force). In
-//! 2D z, qx, qy, wx, wy, fz, tx and ty are zero.
+//! step (pressure and viscosity; not gravity, the body's external force nor the contacts'
+//! impulses). In 2D z, qx, qy, wx, wy, fz, tx and ty are zero.
 
 use super::csv::{end_of_row, CsvWriter, CutAt};
 use super::OutputError;
