@@ -244,3 +244,58 @@ max = {tank:?}
 {extra}"#
     )
 }
+
+/// A tank `width` × `height` with water `depth` deep (dx = `spacing`), gravity along −y (−z in
+/// 3D), frames every `interval` s, and the sections `body` after it (bodies, a trajectory).
+pub fn tank(
+    dims: usize,
+    spacing: f64,
+    size: [f64; 3],
+    depth: f64,
+    interval: f64,
+    body: &str,
+) -> String {
+    let v = |x: &[f64]| {
+        format!(
+            "[{}]",
+            x[..dims]
+                .iter()
+                .map(|x| format!("{x:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    let mut gravity = [0.0; 3];
+    gravity[dims - 1] = -9.81;
+    let mut block = size;
+    block[dims - 1] = depth;
+    format!(
+        r#"[simulation]
+dimensions = {dims}
+spacing = {spacing:?}
+end_time = 10.0
+output_interval = {interval:?}
+gravity = {g}
+
+[[fluid]]
+name = "water"
+density = 1000.0
+viscosity = 1.0e-6
+
+[[fluid_block]]
+fluid = "water"
+min = {zero}
+max = {block}
+
+[container]
+min = {zero}
+max = {size}
+
+{body}
+"#,
+        g = v(&gravity),
+        zero = v(&[0.0; 3]),
+        block = v(&block),
+        size = v(&size),
+    )
+}

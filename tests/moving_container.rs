@@ -2,7 +2,7 @@
 //! slowly keeps its water level in the laboratory; the SPHERIC 10 sloshing tank's wall impacts
 //! come once per period as the experiment's do.
 
-use crate::common::{read_frame, run_scene, shipped_scene, TempDir};
+use crate::common::{read_frame, run_scene, shipped_scene, tank, TempDir};
 use isph::io::probes;
 use isph::Scene;
 
@@ -47,31 +47,8 @@ fn a_tank_tilted_slowly_keeps_its_water_level_in_the_laboratory() {
     }
     table += "10.0,0,0,10.0\n";
     std::fs::write(dir.path().join("tilt.csv"), table).unwrap();
-    let text = r#"[simulation]
-dimensions = 2
-spacing = 0.01
-end_time = 4.0
-output_interval = 0.05
-gravity = [0.0, -9.81]
-
-[[fluid]]
-name = "water"
-density = 1000.0
-viscosity = 1.0e-6
-
-[[fluid_block]]
-fluid = "water"
-min = [0.0, 0.0]
-max = [0.6, 0.2]
-
-[container]
-min = [0.0, 0.0]
-max = [0.6, 0.4]
-
-[container.trajectory]
-pivot = [0.3, 0.0]
-table = "tilt.csv"
-"#;
+    let trajectory = "[container.trajectory]\npivot = [0.3, 0.0]\ntable = \"tilt.csv\"\n";
+    let text = tank(2, 0.01, [0.6, 0.4, 0.0], 0.2, 0.05, trajectory);
     let path = dir.path().join("tilt.toml");
     std::fs::write(&path, text).unwrap();
     let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));

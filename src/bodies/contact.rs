@@ -21,6 +21,7 @@
 
 use super::{outward_normal, Bodies, RigidBody};
 use crate::math::rotation::{self, cross, Vec3};
+use crate::math::vector::dot;
 use crate::scene::BodyMotion;
 
 /// Passes over all contacts per step: a stack of bodies on the floor needs more than one for a
@@ -36,40 +37,29 @@ struct Touch {
     depth: f64,
 }
 
-/// The surface a body touches besides another body: container faces and obstacles do not move.
-struct Fixed {
-    restitution: f64,
-    friction: f64,
-}
-
 impl Bodies {
     /// Resolves the contacts of the bodies after their move over the step from `time`.
     pub fn resolve_contacts(&mut self, time: f64) {
-        let dims = self.dims;
+        let (dims, gap) = (self.dims, 0.5 * self.spacing);
         for _ in 0..PASSES {
             let mut touched = false;
             for a in 0..self.bodies.len() {
                 if !moves_freely(&self.bodies[a], time) {
                     continue;
                 }
-                let gap = 0.5 * self.spacing;
-                let faces: Vec<Touch> = self.faces_touched(a, gap);
+                let points = world_points(&self.bodies[a]);
+                let faces: Vec<Touch> = self.faces_touched(&points, gap);
                 let obstacles: Vec<Touch> = self
                     .obstacles
                     .iter()
                     .filter_map(|o| {
                         let distance = |x: &Vec3| o.signed_distance(&x[..dims]);
-                        deepest_in(&self.bodies[a], &distance, gap, dims)
+                        deepest_in(&points, &distance, gap, dims)
                     })
                     .collect();
                 for touch in faces.into_iter().chain(obstacles) {
-                    let body = &self.bodies[a];
-                    let fixed = Fixed {
-                        restitution: body.restitution,
-                        friction: body.friction,
-                    };
                     touched = true;
-                    push_off_fixed(&mut self.bodies[a], &fixed, touch, dims);
+                    push_off_fixed(&mut self.bodies[a], touch, dims);
                 }
             }
             for a in 0..self.bodies.len() {
@@ -94,15 +84,15 @@ impl Bodies {
         }
     }
 
-    /// The container faces body a comes closer to than `gap`, each with its contact.
-    fn faces_touched(&self, a: usize, gap: f64) -> Vec<Touch> {
-        let points = world_points(&self.bodies[a]);
+    /// The container faces a body whose particles are at `points` comes closer to than `gap`,
+    /// each with its contact.
+    fn faces_touched(&self, points: &[Vec3], gap: f64) -> Vec<Touch> {
         let mut touches = Vec::new();
         for (d, face) in self.faces.iter().enumerate() {
             let Some((lo, hi)) = *face else { continue };
             for (plane, sign) in [(lo, 1.0), (hi, -1.0)] {
                 let depth = |x: &Vec3| gap - sign * (x[d] - plane);
-                if let Some((point, depth)) = contact_patch(&points, depth) {
+                if let Some((point, depth)) = contact_patch(points, depth) {
                     let mut normal = [0.0; 3];
                     normal[d] = sign;
                     touches.push(Touch {
@@ -128,8 +118,19 @@ impl Bodies {
             return None;
         }
         let dims = self.dims;
-        let a_in_b = deepest_in(ba, &|x| bb.surface_distance(x, dims), gap, dims);
-        let b_in_a = deepest_in(bb, &|x| ba.surface_distance(x, dims), gap, dims).map(|t| Touch {
+        let a_in_b = deepest_in(
+            &world_points(ba),
+            &|x| bb.surface_distance(x, dims),
+            gap,
+            dims,
+        );
+        let b_in_a = deepest_in(
+            &world_points(bb),
+            &|x| ba.surface_distance(x, dims),
+            gap,
+            dims,
+        )
+        .map(|t| Touch {
             normal: t.normal.map(|n| -n),
             ..t
         });
@@ -158,17 +159,18 @@ fn world_points(body: &RigidBody) -> Vec<Vec3> {
         .collect()
 }
 
-/// The contact of `body` with the surface whose signed distance is `distance`: its particles
-/// closer to it than `gap` (None if none is), their depth-weighted centre as the point (a body
-/// lying flat on a surface is pushed at the middle of what touches, not at one corner), the
-/// largest depth, and the surface's outward normal at the point (`outward_normal`).
+/// The contact of a body whose particles are at `points` with the surface whose signed distance
+/// is `distance`: its particles closer to it than `gap` (None if none is), their depth-weighted
+/// centre as the point (a body lying flat on a surface is pushed at the middle of what touches,
+/// not at one corner), the largest depth, and the surface's outward normal at the point
+/// (`outward_normal`).
 fn deepest_in(
-    body: &RigidBody,
+    points: &[Vec3],
     distance: &dyn Fn(&Vec3) -> f64,
     gap: f64,
     dims: usize,
 ) -> Option<Touch> {
-    let (point, depth) = contact_patch(&world_points(body), |x| gap - distance(x))?;
+    let (point, depth) = contact_patch(points, |x| gap - distance(x))?;
     let normal = outward_normal(distance, point, gap, dims)?;
     Some(Touch {
         point,
@@ -193,8 +195,9 @@ fn contact_patch(points: &[Vec3], depth: impl Fn(&Vec3) -> f64) -> Option<(Vec3,
     (weight > 0.0).then(|| (sum.map(|s| s / weight), deepest))
 }
 
-/// Pushes free body `a` off a fixed surface at `touch`.
-fn push_off_fixed(a: &mut RigidBody, fixed: &Fixed, touch: Touch, dims: usize) {
+/// Pushes free body `a` off a surface that does not move (a container face, an obstacle) at
+/// `touch`, with the body's own restitution and friction.
+fn push_off_fixed(a: &mut RigidBody, touch: Touch, dims: usize) {
     for d in 0..dims {
         a.state.centre[d] += touch.depth * touch.normal[d];
     }
@@ -204,8 +207,8 @@ fn push_off_fixed(a: &mut RigidBody, fixed: &Fixed, touch: Touch, dims: usize) {
         relative,
         touch.normal,
         [Some((a as &RigidBody, arm)), None],
-        fixed.restitution,
-        fixed.friction,
+        a.restitution,
+        a.friction,
     );
     if let Some(j) = j {
         kick(a, arm, j, 1.0);
@@ -307,8 +310,4 @@ fn kick(body: &mut RigidBody, arm: Vec3, p: Vec3, sign: f64) {
         body.state.velocity[d] += sign * p[d] / body.mass;
         body.state.angular_momentum[d] += sign * turn[d];
     }
-}
-
-fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

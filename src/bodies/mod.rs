@@ -5,12 +5,13 @@
 //! body's particles: with m_i the particle masses, M = Σ m_i and r_ic the particle's offset from
 //! the centre of mass,
 //!
-//!   M (Vⁿ⁺¹ − Vⁿ) = Σ m_i (u_i − u_i^rigid) + Δt F_ext,     Eq. (14), as a momentum balance
+//!   M (Vⁿ⁺¹ − Vⁿ) = Σ m_i (u_i − u_i^rigid),                Eq. (14), as a momentum balance
 //!   Lⁿ⁺¹ − Lⁿ     = Σ m_i r_ic × (u_i − u_i^rigid),          Eq. (15), angular momentum
 //!   ωⁿ⁺¹ = R I⁻¹ Rᵀ Lⁿ⁺¹,  u_i = Vⁿ⁺¹ + ωⁿ⁺¹ × r_ic,          Eq. (16)
 //!
-//! with u_i the corrector's velocity of particle i and u_i^rigid its rigid velocity at the start
-//! of the step (docs/bodies.md, "The coupling"). The paper's scalar I_O of Eq. (13) is the
+//! with u_i the corrector's velocity of particle i, whose predictor carried the body's
+//! external force over its mass with gravity (`step::body_forces`), and u_i^rigid its rigid
+//! velocity at the start of the step (docs/bodies.md, "The coupling"). The paper's scalar I_O of Eq. (13) is the
 //! polar moment, exact in 2D only; here I = Σ m_i (|r_ic|² 1 − r_ic ⊗ r_ic) in the body's own
 //! frame, turned into the world's by the orientation, a unit quaternion. Angular momentum, not
 //! an angle, is the integrated quantity, so a torque-free body keeps it to round-off. The state
@@ -22,6 +23,7 @@ mod contact;
 use crate::math::aabb::Aabb;
 use crate::math::rotation::{self, cross, Mat3, Quaternion, Vec3};
 use crate::math::shape::Shape;
+use crate::math::vector::dot;
 use crate::particles::{Kind, Particles};
 use crate::scene::{BodyMotion, Scene};
 
@@ -196,7 +198,7 @@ impl RigidBody {
             self.angular_velocity(),
             self.state.angular_momentum,
         );
-        0.5 * self.mass * dot3(v, v) + 0.5 * dot3(w, l)
+        0.5 * self.mass * dot(v, v) + 0.5 * dot(w, l)
     }
 }
 
@@ -263,7 +265,7 @@ impl Bodies {
                     })
                     .sum::<f64>()
                     .sqrt();
-                RigidBody {
+                let mut rigid = RigidBody {
                     name: body.name.clone(),
                     shape: body.shape.clone(),
                     centre_at_start: centre,
@@ -290,19 +292,14 @@ impl Bodies {
                         force: [0.0; 3],
                         torque: [0.0; 3],
                     },
-                }
-            })
-            .collect::<Vec<RigidBody>>();
-        let bodies = bodies
-            .into_iter()
-            .map(|mut body| {
+                };
                 // A prescribed body starts moving as its trajectory does at t = 0.
-                if let Some(target) = body.target(0.0, 0.0) {
-                    body.state.velocity = target.velocity;
-                    body.state.angular_momentum =
-                        rotation::apply(&body.inertia, target.angular_velocity);
+                if let Some(target) = rigid.target(0.0, 0.0) {
+                    rigid.state.velocity = target.velocity;
+                    rigid.state.angular_momentum =
+                        rotation::apply(&inertia, target.angular_velocity);
                 }
-                body
+                rigid
             })
             .collect();
         let c: &Aabb = &scene.container;
@@ -361,8 +358,8 @@ impl Bodies {
 
     /// Advances body b's state over the step from `time` to `time + dt` from the momentum
     /// `impulse` and angular momentum `angular_impulse` the step's fluid stages gave its particles
-    /// beyond their rigid motion, `applied` and `applied_torque` of them the body forces' (the
-    /// sums of m_i f_i and r_ic × m_i f_i, `ghosts::BodyForce`); a fixed or prescribed one is
+    /// beyond their rigid motion, `applied` the body forces' share of them per unit time (the
+    /// sums of m_i f_i and of r_ic × m_i f_i, `ghosts::BodyForce`); a fixed or prescribed one is
     /// put where its motion says. The contacts are resolved after every body has moved
     /// (`resolve_contacts`).
     pub fn advance(
@@ -473,7 +470,7 @@ impl Bodies {
 fn inertia_tensor(offsets: &[Vec3], masses: &[f64], dims: usize) -> Mat3 {
     let mut inertia = [[0.0; 3]; 3];
     for (r, m) in offsets.iter().zip(masses) {
-        let r2 = dot3(*r, *r);
+        let r2 = dot(*r, *r);
         for a in 0..3 {
             for b in 0..3 {
                 let delta = if a == b { r2 } else { 0.0 };
@@ -507,7 +504,7 @@ pub(crate) fn outward_normal(
         minus[d] -= eps;
         (distance(&plus) - distance(&minus)) / (2.0 * eps)
     });
-    let length = dot3(gradient, gradient).sqrt();
+    let length = dot(gradient, gradient).sqrt();
     (length > 0.0).then(|| gradient.map(|g| g / length))
 }
 
@@ -515,8 +512,4 @@ pub(crate) fn outward_normal(
 pub fn rigid_velocity(velocity: Vec3, omega: Vec3, arm: Vec3) -> Vec3 {
     let w = cross(omega, arm);
     std::array::from_fn(|d| velocity[d] + w[d])
-}
-
-fn dot3(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

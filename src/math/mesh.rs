@@ -5,6 +5,8 @@
 //! where |w| > ½. The distance to the surface is to the nearest triangle.
 
 use super::aabb::Aabb;
+use super::rotation::cross;
+use super::vector::{dot, norm};
 
 /// A triangle mesh in 3D.
 #[derive(Clone, Debug, PartialEq)]
@@ -157,22 +159,6 @@ fn along(a: [f64; 3], edge: [f64; 3], t: f64) -> [f64; 3] {
 
 fn sub(a: [f64; 3], b: &[f64]) -> [f64; 3] {
     std::array::from_fn(|d| a[d] - b[d])
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 #[cfg(test)]

@@ -6,8 +6,9 @@
 //! plus the pressure acceleration the last step's pressure gave it, ∇Pⁿ/ρ0: the corrector
 //! takes the new one off, so the solve leaves the body at its rigid velocity up to the change
 //! of ∇P over a step, and the fluid around it sees a body that is held, not one that yields
-//! to the pressure and is put back each step (which stirs still water around a fixed body). The predictor adds f_i (Eq. 5), the wall
-//! ghosts carry it, and `rigid_bodies` takes its sums over each body out of the fluid's force.
+//! to the pressure and is put back each step (which stirs still water around a fixed body).
+//! The predictor adds f_i (Eq. 5), the wall ghosts carry it, and `rigid_bodies` takes its sums
+//! over each body out of the fluid's force.
 //! Runs only in a scene with bodies or a moving container.
 
 use super::corrector::pressure_gradient;
