@@ -369,6 +369,11 @@ fn each_bad_body_is_refused_with_its_key() {
         ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\nmin = [0.0, 0.0]\ndensity = 500.0", &["body[0].min", "not a key of a circle"]),
         ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05", &["body[0]", "neither `density`"]),
         ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0\nfriction = -0.1", &["body[0].friction", "≥ 0"]),
+        ("shape = \"union\"\ndensity = 500.0", &["body[0].part", "has 0", "two shapes or more"]),
+        ("shape = \"union\"\ncenter = [0.1, 0.1]\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\n[[body.part]]\nshape = \"circle\"\ncenter = [0.15, 0.1]\nradius = 0.05", &["body[0].center", "not a key of a union"]),
+        ("shape = \"union\"\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\n[[body.part]]\nshape = \"union\"", &["body[0].part[1].shape", "\"union\" is not a shape a union's part takes"]),
+        ("shape = \"union\"\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\n[[body.part]]\nshape = \"box\"\nmin = [0.1, 0.1]", &["body[0].part[1].max", "missing"]),
+        ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05", &["body[0].part", "is for a union"]),
     ];
     for (text, expected) in cases {
         let (code, stderr) = run_text(dir.path(), &body(text), &[]);

@@ -22,6 +22,8 @@ pub enum Shape {
     },
     /// A closed triangle mesh (3D), inside by its winding number (`mesh`).
     Mesh(TriangleMesh),
+    /// The union of its parts (none a union): inside where any part is.
+    Union(Vec<Shape>),
 }
 
 impl Shape {
@@ -33,10 +35,13 @@ impl Shape {
             Shape::Ball { .. } => "sphere",
             Shape::Cylinder { .. } => "cylinder",
             Shape::Mesh(_) => "mesh",
+            Shape::Union(_) => "union",
         }
     }
 
-    /// Signed distance from x to the surface: negative inside.
+    /// Signed distance from x to the surface: negative inside. A union's is the least of its
+    /// parts': exact outside it, where the fluid's and the bodies' contacts ask; inside, where
+    /// parts overlap, it may overstate how near the surface is, never the sign.
     pub fn signed_distance(&self, x: &[f64]) -> f64 {
         match self {
             Shape::Box { min, max } => {
@@ -62,6 +67,10 @@ impl Shape {
                 slab_distance(&[radial, along])
             }
             Shape::Mesh(mesh) => mesh.signed_distance(x),
+            Shape::Union(parts) => parts
+                .iter()
+                .map(|part| part.signed_distance(x))
+                .fold(f64::INFINITY, f64::min),
         }
     }
 
@@ -76,6 +85,7 @@ impl Shape {
         match self {
             // The winding number alone: no distance to find.
             Shape::Mesh(mesh) => mesh.contains(x),
+            Shape::Union(parts) => parts.iter().any(|part| part.contains(x)),
             _ => self.signed_distance(x) < 0.0,
         }
     }
@@ -104,6 +114,19 @@ impl Shape {
                 }
             }
             Shape::Mesh(mesh) => mesh.bounds().clone(),
+            Shape::Union(parts) => {
+                let bounds: Vec<Aabb> = parts.iter().map(Shape::bounds).collect();
+                let dims = bounds[0].min.len();
+                let extreme = |pick: fn(&Aabb, usize) -> f64, towards: fn(f64, f64) -> f64| {
+                    (0..dims)
+                        .map(|d| bounds.iter().map(|b| pick(b, d)).reduce(towards).unwrap())
+                        .collect()
+                };
+                Aabb {
+                    min: extreme(|b, d| b.min[d], f64::min),
+                    max: extreme(|b, d| b.max[d], f64::max),
+                }
+            }
         }
     }
 }

@@ -57,6 +57,39 @@ pub(super) struct BodySection {
     pub(super) angular_velocity: Option<Vec<f64>>,
     pub(super) trajectory: Option<TrajectorySection>,
     pub(super) release: Option<f64>,
+    pub(super) part: Option<Vec<ShapeSection>>,
+}
+
+impl BodySection {
+    /// The keys that place the body's own shape.
+    pub(super) fn shape_keys(&self) -> ShapeSection {
+        ShapeSection {
+            shape: self.shape.clone(),
+            min: self.min.clone(),
+            max: self.max.clone(),
+            center: self.center.clone(),
+            radius: self.radius,
+            axis: self.axis.clone(),
+            length: self.length,
+            mesh: self.mesh.clone(),
+            offset: self.offset.clone(),
+        }
+    }
+}
+
+/// The keys that place a shape: a `[[body]]`'s own, or a `[[body.part]]` of a union.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ShapeSection {
+    pub(super) shape: String,
+    pub(super) min: Option<Vec<f64>>,
+    pub(super) max: Option<Vec<f64>>,
+    pub(super) center: Option<Vec<f64>>,
+    pub(super) radius: Option<f64>,
+    pub(super) axis: Option<String>,
+    pub(super) length: Option<f64>,
+    pub(super) mesh: Option<String>,
+    pub(super) offset: Option<Vec<f64>>,
 }
 
 /// `[container.trajectory]` and `[body.trajectory]` as written: a sinusoid (`period`,

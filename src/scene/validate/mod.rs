@@ -8,7 +8,7 @@ use crate::math::mesh::TriangleMesh;
 
 use super::file::{
     BodySection, BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection,
-    ProbeSection, SceneFile, ShiftingSection, SimulationSection, SurfaceSection,
+    ProbeSection, SceneFile, ShapeSection, ShiftingSection, SimulationSection, SurfaceSection,
 };
 use super::{
     Aabb, Block, Body, BodyMass, BodyMotion, CheckpointSettings, Effects, InitialVelocity,
@@ -698,7 +698,7 @@ impl Validator<'_> {
                 &format!("{key}.name"),
                 format!("= \"{name}\" is the name of an earlier [[body]]: give each body its own"),
             )?;
-            let shape = self.shape(b, &key, dims, s.spacing)?;
+            let shape = self.body_shape(b, &key, dims, s.spacing)?;
             let bounds = shape.bounds();
             self.check(
                 bounds.within(container),
@@ -877,14 +877,59 @@ impl Validator<'_> {
         }
     }
 
-    /// The shape of `[[body]]` section `b`: its `shape` known in `dims` dimensions, the keys
-    /// it needs given and valid, the keys of other shapes absent.
-    fn shape(
+    /// The shape of `[[body]]` section `b`: its own (`shape`), or with `shape = "union"` the
+    /// union of its `[[body.part]]`s, each a shape of its own keys and none a union.
+    fn body_shape(
         &self,
         b: &BodySection,
         key: &str,
         dims: usize,
         spacing: f64,
+    ) -> Result<Shape, SceneError> {
+        let keys = b.shape_keys();
+        if b.shape != "union" {
+            self.check(
+                b.part.is_none(),
+                &format!("{key}.part"),
+                format!("is for a union: this body is a {}; set `shape = \"union\"` or leave the parts out", b.shape),
+            )?;
+            return self.shape(&keys, key, dims, spacing, &["union"]);
+        }
+        let offset = ("offset", keys.offset.is_some());
+        for (name, present) in shape_keys_given(&keys).into_iter().chain([offset]) {
+            self.check(
+                !present,
+                &format!("{key}.{name}"),
+                "is not a key of a union: each [[body.part]] takes its own shape's keys",
+            )?;
+        }
+        let parts = b.part.as_deref().unwrap_or_default();
+        self.check(
+            parts.len() >= 2,
+            &format!("{key}.part"),
+            format!(
+                "has {} [[body.part]]: a union joins two shapes or more",
+                parts.len()
+            ),
+        )?;
+        let shapes = parts
+            .iter()
+            .enumerate()
+            .map(|(m, part)| self.shape(part, &format!("{key}.part[{m}]"), dims, spacing, &[]))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Shape::Union(shapes))
+    }
+
+    /// The shape of section `b` (a body's own or a union's part): its `shape` known in `dims`
+    /// dimensions, the keys it needs given and valid, the keys of other shapes absent; `more`
+    /// names the shapes built elsewhere that the section's place also takes, for the message.
+    fn shape(
+        &self,
+        b: &ShapeSection,
+        key: &str,
+        dims: usize,
+        spacing: f64,
+        more: &[&str],
     ) -> Result<Shape, SceneError> {
         let shapes: &[&str] = if dims == 2 {
             &["box", "circle"]
@@ -895,24 +940,22 @@ impl Validator<'_> {
             shapes.contains(&b.shape.as_str()),
             &format!("{key}.shape"),
             format!(
-                "= \"{}\" is not a shape of a {dims}D scene: one of {}",
+                "= \"{}\" is not a shape {} {dims}D scene: one of {}",
                 b.shape,
+                if more.is_empty() {
+                    "a union's part takes in a"
+                } else {
+                    "of a"
+                },
                 shapes
                     .iter()
+                    .chain(more)
                     .map(|n| format!("\"{n}\""))
                     .collect::<Vec<_>>()
                     .join(", ")
             ),
         )?;
-        let given = [
-            ("min", b.min.is_some()),
-            ("max", b.max.is_some()),
-            ("center", b.center.is_some()),
-            ("radius", b.radius.is_some()),
-            ("axis", b.axis.is_some()),
-            ("length", b.length.is_some()),
-            ("mesh", b.mesh.is_some()),
-        ];
+        let given = shape_keys_given(b);
         let needs: &[&str] = match b.shape.as_str() {
             "box" => &["min", "max"],
             "cylinder" => &["center", "radius", "axis", "length"],
@@ -1047,6 +1090,19 @@ impl Validator<'_> {
             keep: keep as usize,
         })
     }
+}
+
+/// Each key that places a shape (besides `shape` and `offset`), and whether `b` gives it.
+fn shape_keys_given(b: &ShapeSection) -> [(&'static str, bool); 7] {
+    [
+        ("min", b.min.is_some()),
+        ("max", b.max.is_some()),
+        ("center", b.center.is_some()),
+        ("radius", b.radius.is_some()),
+        ("axis", b.axis.is_some()),
+        ("length", b.length.is_some()),
+        ("mesh", b.mesh.is_some()),
+    ]
 }
 
 /// The lattice points of the scene's particle lattice (`fill`: container.min + (k + ½) dx)
