@@ -10,7 +10,7 @@ use crate::scene::{Block, BodyMass, Scene};
 
 /// Particles of the scene at t = 0: fluid first (in block order), then walls, then each body's
 /// particles (in the order of the scene's bodies, so that a body's ids are contiguous). No
-/// fluid starts inside a body or within half a spacing of it.
+/// fluid starts inside a body.
 pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let dx = scene.spacing;
     let volume = dx.powi(D as i32);
@@ -18,7 +18,7 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let cells = container_cells::<D>(scene);
     let point = |k: [i64; D]| lattice_point(scene, k);
     let in_obstacle = |x: &[f64; D]| in_obstacle(scene, x);
-    let kept_clear = |x: &[f64; D]| near_obstacle(scene, x) || near_body(scene, x);
+    let kept_clear = |x: &[f64; D]| near_obstacle(scene, x) || in_a_body(scene, x);
 
     let mut particles = Particles::<D>::default();
     for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
@@ -99,17 +99,16 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     particles
 }
 
-/// How many lattice points of the fluid blocks each body keeps clear of fluid (inside it or
-/// within half a spacing of it, and clear of the obstacles and of the bodies before it).
+/// How many lattice points of the fluid blocks each body keeps clear of fluid (inside it, and
+/// clear of the obstacles and of the bodies before it).
 pub fn displaced_by_bodies<const D: usize>(scene: &Scene) -> Vec<usize> {
-    let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
     let mut displaced = vec![0; scene.bodies.len()];
     for_each_lattice_point([0; D], container_cells::<D>(scene), |k| {
         let x = lattice_point(scene, k);
         if block_of(scene, &x).is_none() || near_obstacle(scene, &x) {
             return;
         }
-        let first = scene.bodies.iter().position(|b| b.shape.near(&x, margin));
+        let first = scene.bodies.iter().position(|b| b.shape.contains(&x));
         if let Some(b) = first {
             displaced[b] += 1;
         }
@@ -117,11 +116,15 @@ pub fn displaced_by_bodies<const D: usize>(scene: &Scene) -> Vec<usize> {
     displaced
 }
 
-/// Whether x lies inside a body or less than half a spacing outside it: no fluid particle
-/// starts there (as at an obstacle, `near_obstacle`).
-fn near_body<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
-    let margin = 0.5 * scene.spacing * (1.0 - 1e-9);
-    scene.bodies.iter().any(|b| b.shape.near(x, margin))
+/// Whether x lies inside a body: no fluid particle starts there. The lattice points outside
+/// keep their fluid, whose nearest body particle is then a spacing off, on the same lattice; one
+/// less than a quarter spacing off a curved surface is moved there by the first step's contact
+/// (`Bodies::keep_out`), by a fraction of that quarter. Leaving out the points within half a
+/// spacing of the surface instead, as at an obstacle, left holes in the water beside a curved
+/// body: water rushing into them stirred the still water around a neutral circle at 0.2 m/s in
+/// its first step (docs/bodies.md, "Measured").
+fn in_a_body<const D: usize>(scene: &Scene, x: &[f64; D]) -> bool {
+    scene.bodies.iter().any(|b| b.shape.contains(x))
 }
 
 /// The block lattice point x belongs to: the first that holds it strictly inside. A point on
@@ -161,7 +164,7 @@ pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) 
     let mut room = 0;
     for_each_lattice_point([0; D], container_cells::<D>(scene), |k| {
         let x = lattice_point(scene, k);
-        room += !(near_obstacle(scene, &x) || near_body(scene, &x)) as usize;
+        room += !(near_obstacle(scene, &x) || in_a_body(scene, &x)) as usize;
     });
     particles.fluid_count() == room
 }

@@ -56,7 +56,8 @@ impl TriangleMesh {
 
     /// Whether p is inside: |w(p)| > ½.
     pub fn contains(&self, p: &[f64]) -> bool {
-        self.winding_number(p).abs() > 0.5
+        // Outside the bounds first: the winding number visits every triangle.
+        self.bounds.contains(p) && self.winding_number(p).abs() > 0.5
     }
 
     /// Distance from p to the nearest point of the mesh's surface.

@@ -74,12 +74,6 @@ impl Shape {
         }
     }
 
-    /// Whether x lies inside or less than `margin` outside (a box test first: a mesh's
-    /// distance visits every triangle).
-    pub fn near(&self, x: &[f64], margin: f64) -> bool {
-        self.bounds().contains_within(x, margin) && self.signed_distance(x) < margin
-    }
-
     /// Whether x lies inside.
     pub fn contains(&self, x: &[f64]) -> bool {
         match self {
