@@ -61,7 +61,8 @@ pub(super) struct BodySection {
 }
 
 impl BodySection {
-    /// The keys that place the body's own shape.
+    /// The keys that place the body's own shape. They are repeated in `BodySection` rather than
+    /// a `ShapeSection` flattened into it: serde does not refuse unknown keys through a flatten.
     pub(super) fn shape_keys(&self) -> ShapeSection {
         ShapeSection {
             shape: self.shape.clone(),
