@@ -153,30 +153,12 @@ density = 500.0
     let scene = scene_from_text(&tank(2, 0.01, [1.0, 0.6, 0.0], 0.3, 0.02, body));
     run_scene(&scene, dir.path(), 3.0);
     let rows = rows(dir.path(), 0);
-    // The draft against the water's own level far from the box (its top particles half a
-    // spacing under the surface), averaged over the heave after the start.
+    // The draft against the water's own level far from the box, averaged over the heave after
+    // the start.
     let frames = rows.len();
-    let mut drafts = Vec::new();
-    for frame in (frames / 3)..frames {
-        let kind: Vec<i32> = read_frame(dir.path(), frame, "kind");
-        let pos: Vec<f64> = read_frame(dir.path(), frame, "position");
-        let far = |i: usize| kind[i] == 0 && (pos[3 * i] < 0.2 || pos[3 * i] > 0.8);
-        // The level: the mean over the columns far from the box of their top particle.
-        let mut tops = std::collections::BTreeMap::new();
-        for i in (0..kind.len()).filter(|&i| far(i)) {
-            let top = tops
-                .entry((pos[3 * i] / 0.01).floor() as i64)
-                .or_insert(f64::MIN);
-            *top = pos[3 * i + 1].max(*top);
-        }
-        let level = tops.values().sum::<f64>() / tops.len() as f64 + 0.005;
-        let bottom = (0..kind.len())
-            .filter(|&i| kind[i] == 2)
-            .map(|i| pos[3 * i + 1])
-            .fold(f64::MAX, f64::min)
-            - 0.005;
-        drafts.push(level - bottom);
-    }
+    let drafts: Vec<f64> = ((frames / 3)..frames)
+        .map(|frame| draft(dir.path(), frame, 2, 0.01, |x| x[0] < 0.2 || x[0] > 0.8))
+        .collect();
     let draft = drafts.iter().sum::<f64>() / drafts.len() as f64;
     let error = draft / 0.05 - 1.0;
     eprintln!(
@@ -195,6 +177,74 @@ density = 500.0
     assert!(
         (fy / weight - 1.0).abs() < 0.05,
         "fluid force {fy} N/m against the weight {weight}"
+    );
+}
+
+/// A box's draft in frame `frame` of a `dims`-dimensional run at spacing `dx`: the level of the
+/// water where `far` holds (the mean over the columns there of their top particle, plus half a
+/// spacing: the surface lies half a spacing above the top particles) less the box's keel (its
+/// lowest particle less half a spacing).
+fn draft(out: &Path, frame: usize, dims: usize, dx: f64, far: impl Fn(&[f64]) -> bool) -> f64 {
+    let kind: Vec<i32> = read_frame(out, frame, "kind");
+    let pos: Vec<f64> = read_frame(out, frame, "position");
+    let up = dims - 1;
+    let mut tops = std::collections::BTreeMap::new();
+    for i in (0..kind.len()).filter(|&i| kind[i] == 0 && far(&pos[3 * i..3 * i + 3])) {
+        let column: Vec<i64> = (0..up)
+            .map(|d| (pos[3 * i + d] / dx).floor() as i64)
+            .collect();
+        let top = tops.entry(column).or_insert(f64::MIN);
+        *top = pos[3 * i + up].max(*top);
+    }
+    let level = tops.values().sum::<f64>() / tops.len() as f64 + 0.5 * dx;
+    let keel = (0..kind.len())
+        .filter(|&i| kind[i] == 2)
+        .map(|i| pos[3 * i + up])
+        .fold(f64::MAX, f64::min)
+        - 0.5 * dx;
+    level - keel
+}
+
+/// The draft of a 3D box 0.2 × 0.2 × 0.1 m at s = 0.5 (b/h = 2, upright-stable), started at its
+/// draft 0.05 m in water 0.12 m deep in a tank 0.3 m square, at spacing `dx`, averaged over the
+/// frames from 0.5 s to `until` against the level in the 0.05 m gaps around it.
+fn box_draft_3d(dx: f64, until: f64) -> f64 {
+    let dir = TempDir::new("bodies-float-3d");
+    let body = "[[body]]\nshape = \"box\"\nmin = [0.05, 0.05, 0.07]\nmax = [0.25, 0.25, 0.17]\ndensity = 500.0\n";
+    let scene = scene_from_text(&tank(3, dx, [0.3, 0.3, 0.25], 0.12, 0.05, body));
+    run_scene(&scene, dir.path(), until);
+    let rows = rows(dir.path(), 0);
+    let gap = |x: &[f64]| x[..2].iter().any(|&c| !(0.05..=0.25).contains(&c));
+    let drafts: Vec<f64> = (0..rows.len())
+        .filter(|&k| rows[k].0 >= 0.5)
+        .map(|frame| draft(dir.path(), frame, 3, dx, gap))
+        .collect();
+    let mean = drafts.iter().sum::<f64>() / drafts.len() as f64;
+    eprintln!(
+        "dx {dx}: draft {mean} ({:+.2}%), frames {drafts:?}",
+        100.0 * (mean / 0.05 - 1.0)
+    );
+    mean
+}
+
+#[test]
+fn a_3d_box_at_half_the_density_of_water_floats_at_half_its_height() {
+    // First order in the spacing: 5 particles in the draft here, +4.7% measured (docs/bodies.md,
+    // "Archimedes"); `…_at_ten_particles_in_the_draft` holds the 3% asked at 10.
+    let draft = box_draft_3d(0.01, 1.0);
+    assert!(
+        (draft / 0.05 - 1.0).abs() < 0.08,
+        "draft {draft} m against 0.05 m"
+    );
+}
+
+#[test]
+#[ignore = "about 25 minutes on 2 cores: run with --ignored"]
+fn a_3d_box_at_half_the_density_of_water_floats_at_half_its_height_at_ten_particles_in_the_draft() {
+    let draft = box_draft_3d(0.005, 2.0);
+    assert!(
+        (draft / 0.05 - 1.0).abs() < 0.03,
+        "draft {draft} m against 0.05 m"
     );
 }
 
