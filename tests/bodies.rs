@@ -804,6 +804,24 @@ fn a_closed_mesh_fills_a_body_or_a_fluid_block_with_its_volume() {
     let water = isph::fill::build::<3>(&scene).fluid_count();
     let floor = 60 * 60 * 10;
     assert_eq!(water - floor, count, "a ball of water from the mesh");
+    // `isph measure` refuses a scene whose first block, the column its references are for, is a
+    // mesh: the box around it is not the water.
+    let only_ball = crate::common::water_block_scene_3d([0.0; 3], [0.6, 0.6, 0.6], 1.0, 0.1, "")
+        .replace(
+            "min = [0.0, 0.0, 0.0]\nmax = [0.0, 0.0, 0.0]",
+            "mesh = \"sphere.stl\"\noffset = [0.3, 0.3, 0.4]",
+        );
+    std::fs::write(&path, only_ball).unwrap();
+    let scene = isph::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    for case in [
+        isph::validation::Case::Hydrostatic,
+        isph::validation::Case::DamBreakFront,
+    ] {
+        let error = isph::validation::check(case, &scene)
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("first fluid block is a mesh"), "{error}");
+    }
 }
 
 /// The lattice positions of the body particles a scene's `[[body]]` text fills, in a 2D tank.

@@ -29,7 +29,9 @@
 //!   `front_rms` and `lead_residual_rms` are the rms of Z_sim(T_k − τ) − Z_k (in widths a)
 //!   without and with the shift: how much of the discrepancy a late start explains.
 
-use super::{fluid, no_frames, surge_vertical, unsuitable, Case, Measured, ValidationError};
+use super::{
+    first_block, fluid, no_frames, surge_vertical, unsuitable, Case, Measured, ValidationError,
+};
 use crate::io::frames::{Frame, FrameReader};
 use crate::scene::Scene;
 use crate::solver::ppe::Role;
@@ -115,7 +117,7 @@ impl Column {
     pub fn new(scene: &Scene) -> Result<Self, ValidationError> {
         let case = Case::DamBreakFront;
         let (v, g) = surge_vertical(case, scene)?;
-        let region = &scene.blocks[0].region;
+        let region = &first_block(case, scene)?.region;
         let back = scene.container.min[0];
         let scene_error = |message: String| unsuitable(case, scene, message);
         if region.min[0] - back > scene.spacing {

@@ -7,7 +7,7 @@
 //! (the lowest row carried to the floor by its own hydrostatic gradient, over ρ0|g|D, minus 1)
 //! and the largest `max_speed` of any step [m/s].
 
-use super::{fluid, last_frame, vertical, Case, Measured, ValidationError};
+use super::{first_block, fluid, last_frame, vertical, Case, Measured, ValidationError};
 use crate::io::stats::read_column;
 use crate::scene::Scene;
 use std::path::Path;
@@ -60,7 +60,7 @@ impl WaterColumn {
 pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
     let case = Case::Hydrostatic;
     let (v, g) = vertical(case, scene)?;
-    let block = &scene.blocks[0];
+    let block = first_block(case, scene)?;
     let column = WaterColumn {
         rho_g: scene.fluids[block.fluid].density * g,
         floor: block.region.min[v],

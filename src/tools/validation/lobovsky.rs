@@ -19,7 +19,7 @@
 //! experiment's), `onset_Pk` (T) and `plateau_Pk` (P/(ρ0 g H)) of the run; a plateau whose window
 //! the run did not reach, or an onset it did not, is NaN.
 
-use super::{surge_vertical, unsuitable, Case, Measured, ValidationError};
+use super::{first_block, surge_vertical, unsuitable, Case, Measured, ValidationError};
 use crate::io::probes;
 use crate::scene::{ProbeField, Scene};
 use std::path::Path;
@@ -144,7 +144,7 @@ impl Tank {
         let case = Case::LobovskyPressure;
         let (v, g) = surge_vertical(case, scene)?;
         let scene_error = |message: String| unsuitable(case, scene, message);
-        let column = &scene.blocks[0].region;
+        let column = &first_block(case, scene)?.region;
         let height = column.max[v] - column.min[v];
         let scale = height / EXPERIMENT_HEIGHT;
         let wall = scene.container.max[0];

@@ -11,7 +11,7 @@ pub mod taylor_green;
 use crate::io::frames::{Frame, FrameReader};
 use crate::io::OutputError;
 use crate::particles::Kind;
-use crate::scene::Scene;
+use crate::scene::{Block, Scene};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
@@ -161,7 +161,7 @@ fn made_from(case: Case, scene: &Scene, run_dir: &Path) -> Result<(), Validation
 /// Whether `scene` suits `case`: what `measure` checks of the scene before it reads a run.
 pub fn check(case: Case, scene: &Scene) -> Result<(), ValidationError> {
     match case {
-        Case::Hydrostatic => vertical(case, scene).map(|_| ()),
+        Case::Hydrostatic => vertical(case, scene).and(first_block(case, scene).map(|_| ())),
         Case::DamBreakFront => dam_break::Column::new(scene).map(|_| ()),
         Case::Poiseuille => poiseuille::Channel::of(scene).map(|_| ()),
         Case::TaylorGreen => taylor_green::Vortex::of(scene).map(|_| ()),
@@ -175,6 +175,20 @@ fn unsuitable(case: Case, scene: &Scene, message: impl Into<String>) -> Validati
         case,
         path: scene.path.clone(),
         message: message.into(),
+    }
+}
+
+/// The first fluid block, the water column or box the case's reference is for: a box, not a
+/// mesh (whose region is only the box around it).
+fn first_block(case: Case, scene: &Scene) -> Result<&Block, ValidationError> {
+    let block = &scene.blocks[0];
+    match block.mesh {
+        None => Ok(block),
+        Some(_) => Err(unsuitable(
+            case,
+            scene,
+            "the first fluid block is a mesh: the reference is for a box of water given by its `min` and `max`",
+        )),
     }
 }
 
