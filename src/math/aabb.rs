@@ -25,4 +25,22 @@ impl Aabb {
     pub fn within(&self, outer: &Aabb) -> bool {
         (0..self.min.len()).all(|d| self.min[d] >= outer.min[d] && self.max[d] <= outer.max[d])
     }
+
+    /// The smallest box holding both.
+    pub fn union(&self, other: &Aabb) -> Aabb {
+        Aabb {
+            min: self
+                .min
+                .iter()
+                .zip(&other.min)
+                .map(|(a, b)| a.min(*b))
+                .collect(),
+            max: self
+                .max
+                .iter()
+                .zip(&other.max)
+                .map(|(a, b)| a.max(*b))
+                .collect(),
+        }
+    }
 }

@@ -108,19 +108,12 @@ impl Shape {
                 }
             }
             Shape::Mesh(mesh) => mesh.bounds().clone(),
-            Shape::Union(parts) => {
-                let bounds: Vec<Aabb> = parts.iter().map(Shape::bounds).collect();
-                let dims = bounds[0].min.len();
-                let extreme = |pick: fn(&Aabb, usize) -> f64, towards: fn(f64, f64) -> f64| {
-                    (0..dims)
-                        .map(|d| bounds.iter().map(|b| pick(b, d)).reduce(towards).unwrap())
-                        .collect()
-                };
-                Aabb {
-                    min: extreme(|b, d| b.min[d], f64::min),
-                    max: extreme(|b, d| b.max[d], f64::max),
-                }
-            }
+            // A union has at least two parts (`validate`).
+            Shape::Union(parts) => parts
+                .iter()
+                .map(Shape::bounds)
+                .reduce(|a, b| a.union(&b))
+                .expect("a union has parts"),
         }
     }
 }

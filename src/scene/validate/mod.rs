@@ -893,7 +893,7 @@ impl Validator<'_> {
                 &format!("{key}.part"),
                 format!("is for a union: this body is a {}; set `shape = \"union\"` or leave the parts out", b.shape),
             )?;
-            return self.shape(&keys, key, dims, spacing, &["union"]);
+            return self.shape(&keys, key, dims, spacing, false);
         }
         let offset = ("offset", keys.offset.is_some());
         for (name, present) in shape_keys_given(&keys).into_iter().chain([offset]) {
@@ -915,21 +915,21 @@ impl Validator<'_> {
         let shapes = parts
             .iter()
             .enumerate()
-            .map(|(m, part)| self.shape(part, &format!("{key}.part[{m}]"), dims, spacing, &[]))
+            .map(|(m, part)| self.shape(part, &format!("{key}.part[{m}]"), dims, spacing, true))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Shape::Union(shapes))
     }
 
-    /// The shape of section `b` (a body's own or a union's part): its `shape` known in `dims`
-    /// dimensions, the keys it needs given and valid, the keys of other shapes absent; `more`
-    /// names the shapes built elsewhere that the section's place also takes, for the message.
+    /// The shape of section `b`, a body's own or (`part`) a union's part: its `shape` known in
+    /// `dims` dimensions, the keys it needs given and valid, the keys of other shapes absent. A
+    /// body may also be a union (`body_shape` builds it), a part not: the message says which.
     fn shape(
         &self,
         b: &ShapeSection,
         key: &str,
         dims: usize,
         spacing: f64,
-        more: &[&str],
+        part: bool,
     ) -> Result<Shape, SceneError> {
         let shapes: &[&str] = if dims == 2 {
             &["box", "circle"]
@@ -942,14 +942,14 @@ impl Validator<'_> {
             format!(
                 "= \"{}\" is not a shape {} {dims}D scene: one of {}",
                 b.shape,
-                if more.is_empty() {
+                if part {
                     "a union's part takes in a"
                 } else {
                     "of a"
                 },
                 shapes
                     .iter()
-                    .chain(more)
+                    .chain(if part { &[][..] } else { &["union"][..] })
                     .map(|n| format!("\"{n}\""))
                     .collect::<Vec<_>>()
                     .join(", ")
