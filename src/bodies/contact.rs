@@ -1,32 +1,57 @@
-//! Contact of the bodies with the container's faces, the obstacles and each other: after the
-//! bodies have moved over a step, a body found closer to another surface than the lattice puts
-//! neighbouring particles is pushed back out and given an impulse at the contact point.
+//! Contact of the bodies with the container's faces, the obstacles and each other, after the
+//! bodies have moved over a step: a body found closer to another surface than the lattice puts
+//! neighbouring particles is pushed back out, and the velocities where they touch stop
+//! approaching.
 //!
-//! Two surfaces touch when a particle of one is less than half a spacing outside the other's
+//! Two surfaces touch where a particle of one is less than half a spacing outside the other's
 //! shape (the shape's surface is half a spacing beyond its outer particles, so at touching the
-//! particles of the two are a spacing apart, as at t = 0). The deepest such particle gives the
-//! contact: its point p, the depth δ and the normal n (the other shape's outward normal there).
-//! Then, with w = 1/M the inverse mass of a body that moves freely (0 for a fixed or prescribed
-//! body, a face or an obstacle) and r the arm from a body's centre to p:
+//! particles of the two are a spacing apart, as at t = 0); its depth is how much less. The
+//! deepest particle gives a contact's depth δ, and the other shape's outward normal n at the
+//! depth-weighted centre p of the particles that touch its normal. With w = 1/M the inverse
+//! mass of a body that moves freely (0 for a fixed or prescribed body, a face or an obstacle)
+//! and r the arm from a body's centre to a point, the effective mass along a direction u at a
+//! point is 1 / (w_a + w_b + u·(I_a⁻¹(r_a × u) × r_a) + u·(I_b⁻¹(r_b × u) × r_b)).
 //!
-//! - the bodies move apart along n by δ, shared as their inverse masses;
-//! - if they approach at p, v_n = (v_a − v_b)·n < 0, the normal impulse
-//!   j = −(1 + e) v_n / (w_a + w_b + n·(I_a⁻¹(r_a × n) × r_a) + n·(I_b⁻¹(r_b × n) × r_b))
-//!   and a Coulomb friction impulse along the sliding direction t, the one that stops the
-//!   sliding, at most μ j, change both bodies' momentum and angular momentum.
+//! 1. **Between bodies**, `PASSES` passes over the pairs in index order (a push at the bottom
+//!    of a pile reaches its top): the two move apart along n by δ, shared as their inverse
+//!    masses, and if they approach at p, v_n = (v_a − v_b)·n < 0, they exchange the impulse of
+//!    a rigid-body collision at p, j = −(1 + e) v_n times the effective mass along n, and a
+//!    Coulomb friction impulse along the sliding direction t that stops the sliding, at most
+//!    μ j.
+//! 2. **With a face or an obstacle**, a body moves out along n by δ (the same passes), and then
+//!    every particle within `SLOP` spacings of touching is a contact point, with the surface's
+//!    normal there. A body lying on a floor touches at many points, and one impulse at one
+//!    point would spin it about that point: a circle's lattice polygon, resting on its bottom
+//!    row, rocked on the floor that way. The impulses of all its points are found together by
+//!    projected Gauss–Seidel with accumulated impulses (sequential impulses, as in Box2D):
+//!    sweep after sweep over the points in order, each point's normal impulse λ ≥ 0 brings its
+//!    normal velocity apart to −e v_n⁰ if it approached at v_n⁰ < 0 before the solve and to 0
+//!    otherwise, and its friction impulse stops its sliding up to the Coulomb bound
+//!    |λ_t| ≤ μ λ. Resting on a face, the solution stops the body's approach and its turn
+//!    together.
 //!
 //! e is the larger of the two restitutions, μ the geometric mean of the two frictions (as
-//! Box2D combines them); a face or an obstacle takes the body's own. The passes run over the
-//! bodies, then the pairs, in index order: the same bits whatever the thread count.
+//! Box2D combines them); a face or an obstacle takes the body's own. Everything runs over the
+//! bodies, the pairs and the points in index order: the same bits whatever the thread count.
 
 use super::{outward_normal, Bodies, RigidBody};
-use crate::math::rotation::{self, cross, Vec3};
+use crate::math::rotation::{self, cross, Mat3, Vec3};
 use crate::math::vector::dot;
 use crate::scene::BodyMotion;
 
-/// Passes over all contacts per step: a stack of bodies on the floor needs more than one for a
-/// push at the bottom to reach the top.
+/// Passes over the separations and the contacts between bodies per step: a stack of bodies on
+/// the floor needs more than one for a push at the bottom to reach the top.
 const PASSES: usize = 4;
+
+/// How near to touching a face or an obstacle, in spacings, a particle counts as a contact
+/// point: the points of a body's side lying on a face differ in depth by its tilt (0.05
+/// spacing is a tilt of 3° across a side a spacing wide), and all of them hold it.
+const SLOP: f64 = 0.05;
+
+/// Most sweeps of the contact points' solve; it stops earlier when a sweep changes no impulse
+/// by more than `TOLERANCE` of the largest.
+const SWEEPS: usize = 200;
+const TOLERANCE: f64 = 1e-12;
 
 /// The deepest point of a contact.
 #[derive(Clone, Copy, Debug)]
@@ -37,44 +62,120 @@ struct Touch {
     depth: f64,
 }
 
+/// A point where a body touches a face or an obstacle.
+#[derive(Clone, Copy, Debug)]
+struct ContactPoint {
+    /// From the body's centre to the point.
+    arm: Vec3,
+    /// The surface's unit normal, towards the body.
+    normal: Vec3,
+    /// The least normal velocity apart the solve leaves at the point.
+    target: f64,
+    normal_impulse: f64,
+    tangent_impulse: Vec3,
+}
+
+/// A body's motion during the solve of its contacts.
+#[derive(Clone, Copy, Debug)]
+struct Motion {
+    velocity: Vec3,
+    angular_momentum: Vec3,
+    angular_velocity: Vec3,
+    /// 1/M and I⁻¹ in the world frame of a body that yields to its contacts; zero for one that
+    /// does not (a fixed or prescribed body).
+    inverse_mass: f64,
+    inverse_inertia: Mat3,
+}
+
+impl Motion {
+    fn of(body: &RigidBody, yields: bool) -> Self {
+        let (inverse_mass, inverse_inertia) = if yields {
+            let inverse = rotation::inverse_on_span(&body.inertia);
+            (
+                1.0 / body.mass,
+                rotation::to_world(&body.rotation(), &inverse),
+            )
+        } else {
+            (0.0, [[0.0; 3]; 3])
+        };
+        Motion {
+            velocity: body.state.velocity,
+            angular_momentum: body.state.angular_momentum,
+            angular_velocity: body.angular_velocity(),
+            inverse_mass,
+            inverse_inertia,
+        }
+    }
+
+    fn velocity_at(&self, arm: Vec3) -> Vec3 {
+        super::rigid_velocity(self.velocity, self.angular_velocity, arm)
+    }
+
+    /// 1/M + u·(I⁻¹(r × u) × r): the inverse effective mass along u at arm r.
+    fn resistance(&self, arm: Vec3, u: Vec3) -> f64 {
+        let turn = cross(rotation::apply(&self.inverse_inertia, cross(arm, u)), arm);
+        self.inverse_mass + dot(u, turn)
+    }
+
+    /// Adds the impulse p at arm r to the momentum and the angular momentum of a body that
+    /// yields.
+    fn kick(&mut self, arm: Vec3, p: Vec3) {
+        if self.inverse_mass == 0.0 {
+            return;
+        }
+        let turn = cross(arm, p);
+        for d in 0..3 {
+            self.velocity[d] += p[d] * self.inverse_mass;
+            self.angular_momentum[d] += turn[d];
+        }
+        self.angular_velocity = rotation::apply(&self.inverse_inertia, self.angular_momentum);
+    }
+}
+
 impl Bodies {
     /// Resolves the contacts of the bodies after their move over the step from `time`.
     pub fn resolve_contacts(&mut self, time: f64) {
+        let free: Vec<bool> = self.bodies.iter().map(|b| moves_freely(b, time)).collect();
+        self.separate(&free);
+        for a in (0..self.bodies.len()).filter(|&a| free[a]) {
+            let mut points = self.contact_points(&self.bodies[a]);
+            if points.is_empty() {
+                continue;
+            }
+            let body = &mut self.bodies[a];
+            let mut motion = Motion::of(body, true);
+            solve_contact_points(&mut points, &mut motion, body.restitution, body.friction);
+            body.state.velocity = motion.velocity;
+            body.state.angular_momentum = motion.angular_momentum;
+        }
+    }
+
+    /// Moves the free bodies (`free`) out of the faces and the obstacles, and the bodies out of
+    /// each other with their collisions' impulses (module doc, 1. and 2.).
+    fn separate(&mut self, free: &[bool]) {
         let (dims, gap) = (self.dims, 0.5 * self.spacing);
         for _ in 0..PASSES {
             let mut touched = false;
-            for a in 0..self.bodies.len() {
-                if !moves_freely(&self.bodies[a], time) {
-                    continue;
-                }
+            for a in (0..self.bodies.len()).filter(|&a| free[a]) {
                 let points = world_points(&self.bodies[a]);
-                let faces: Vec<Touch> = self.faces_touched(&points, gap);
-                let obstacles: Vec<Touch> = self
-                    .obstacles
-                    .iter()
-                    .filter_map(|o| {
-                        let distance = |x: &Vec3| o.signed_distance(&x[..dims]);
-                        deepest_in(&points, &distance, gap, dims)
-                    })
-                    .collect();
-                for touch in faces.into_iter().chain(obstacles) {
+                let mut touches = self.faces_touched(&points, gap);
+                touches.extend(self.obstacles.iter().filter_map(|o| {
+                    let distance = |x: &Vec3| o.signed_distance(&x[..dims]);
+                    deepest_in(&points, &distance, gap, dims)
+                }));
+                for touch in touches {
                     touched = true;
-                    push_off_fixed(&mut self.bodies[a], touch, dims);
+                    for d in 0..dims {
+                        self.bodies[a].state.centre[d] += touch.depth * touch.normal[d];
+                    }
                 }
             }
             for a in 0..self.bodies.len() {
-                for b in a + 1..self.bodies.len() {
-                    let (free_a, free_b) = (
-                        moves_freely(&self.bodies[a], time),
-                        moves_freely(&self.bodies[b], time),
-                    );
-                    if !(free_a || free_b) {
-                        continue;
-                    }
+                for b in (a + 1..self.bodies.len()).filter(|&b| free[a] || free[b]) {
                     if let Some(touch) = self.pair_touch(a, b) {
                         touched = true;
                         let (head, tail) = self.bodies.split_at_mut(b);
-                        push_apart(&mut head[a], free_a, &mut tail[0], free_b, touch, dims);
+                        push_apart(&mut head[a], free[a], &mut tail[0], free[b], touch, dims);
                     }
                 }
             }
@@ -93,11 +194,9 @@ impl Bodies {
             for (plane, sign) in [(lo, 1.0), (hi, -1.0)] {
                 let depth = |x: &Vec3| gap - sign * (x[d] - plane);
                 if let Some((point, depth)) = contact_patch(points, depth) {
-                    let mut normal = [0.0; 3];
-                    normal[d] = sign;
                     touches.push(Touch {
                         point,
-                        normal,
+                        normal: axis(d, sign),
                         depth,
                     });
                 }
@@ -139,12 +238,170 @@ impl Bodies {
             (x, y) => x.or(y),
         }
     }
+
+    /// The contact points of `body` with the faces and the obstacles: its particles within
+    /// `SLOP` spacings of touching, with the surface's normal there.
+    fn contact_points(&self, body: &RigidBody) -> Vec<ContactPoint> {
+        let (dims, gap) = (self.dims, 0.5 * self.spacing);
+        let near = gap + SLOP * self.spacing;
+        let points = world_points(body);
+        let mut found = Vec::new();
+        for (d, face) in self.faces.iter().enumerate() {
+            let Some((lo, hi)) = *face else { continue };
+            for (plane, sign) in [(lo, 1.0), (hi, -1.0)] {
+                for x in points.iter().filter(|x| sign * (x[d] - plane) < near) {
+                    found.push(ContactPoint::new(body, *x, axis(d, sign)));
+                }
+            }
+        }
+        for o in &self.obstacles {
+            let distance = |x: &Vec3| o.signed_distance(&x[..dims]);
+            for x in points.iter().filter(|x| distance(x) < near) {
+                if let Some(n) = outward_normal(&distance, *x, gap, dims) {
+                    found.push(ContactPoint::new(body, *x, n));
+                }
+            }
+        }
+        found
+    }
+}
+
+impl ContactPoint {
+    fn new(body: &RigidBody, x: Vec3, normal: Vec3) -> Self {
+        ContactPoint {
+            arm: arm_to(body, x),
+            normal,
+            target: 0.0,
+            normal_impulse: 0.0,
+            tangent_impulse: [0.0; 3],
+        }
+    }
+}
+
+/// The impulses of all of a body's contact points with the faces and the obstacles together,
+/// by projected Gauss–Seidel (module doc, 2.), with the body's `restitution` and `friction`.
+fn solve_contact_points(
+    points: &mut [ContactPoint],
+    motion: &mut Motion,
+    restitution: f64,
+    friction: f64,
+) {
+    for c in points.iter_mut() {
+        let approach = dot(motion.velocity_at(c.arm), c.normal);
+        c.target = -restitution * approach.min(0.0);
+    }
+    for _ in 0..SWEEPS {
+        let (mut change, mut largest) = (0.0f64, 0.0f64);
+        for c in points.iter_mut() {
+            change = change.max(solve_point(c, motion, friction));
+            largest = largest.max(c.normal_impulse);
+        }
+        if change <= TOLERANCE * largest {
+            break;
+        }
+    }
+}
+
+/// One sweep's update of contact point c: its normal impulse, then its friction impulse, each
+/// accumulated and clamped (λ ≥ 0, |λ_t| ≤ μ λ) and the change applied to the body; returns
+/// the larger change.
+fn solve_point(c: &mut ContactPoint, motion: &mut Motion, friction: f64) -> f64 {
+    let n = c.normal;
+    let vn = dot(motion.velocity_at(c.arm), n);
+    let total = (c.normal_impulse + (c.target - vn) / motion.resistance(c.arm, n)).max(0.0);
+    let normal_change = total - c.normal_impulse;
+    c.normal_impulse = total;
+    motion.kick(c.arm, n.map(|x| normal_change * x));
+    if friction == 0.0 {
+        return normal_change.abs();
+    }
+    let relative = motion.velocity_at(c.arm);
+    let vn = dot(relative, n);
+    let sliding: Vec3 = std::array::from_fn(|d| relative[d] - vn * n[d]);
+    let speed = dot(sliding, sliding).sqrt();
+    let mut tangent = c.tangent_impulse;
+    if speed > 0.0 {
+        let t = sliding.map(|s| s / speed);
+        let stop = speed / motion.resistance(c.arm, t);
+        for d in 0..3 {
+            tangent[d] -= stop * t[d];
+        }
+    }
+    let size = dot(tangent, tangent).sqrt();
+    let bound = friction * c.normal_impulse;
+    if size > bound {
+        tangent = tangent.map(|x| x * bound / size);
+    }
+    let tangent_change: Vec3 = std::array::from_fn(|d| tangent[d] - c.tangent_impulse[d]);
+    c.tangent_impulse = tangent;
+    motion.kick(c.arm, tangent_change);
+    normal_change
+        .abs()
+        .max(dot(tangent_change, tangent_change).sqrt())
+}
+
+/// Pushes bodies a and b apart at `touch` (its normal towards a), with the impulse of their
+/// collision there if they approach (module doc, 1.); `free_a`, `free_b` whether each yields.
+fn push_apart(
+    a: &mut RigidBody,
+    free_a: bool,
+    b: &mut RigidBody,
+    free_b: bool,
+    touch: Touch,
+    dims: usize,
+) {
+    let (mut ma, mut mb) = (Motion::of(a, free_a), Motion::of(b, free_b));
+    let (wa, wb) = (ma.inverse_mass, mb.inverse_mass);
+    for d in 0..dims {
+        a.state.centre[d] += touch.depth * wa / (wa + wb) * touch.normal[d];
+        b.state.centre[d] -= touch.depth * wb / (wa + wb) * touch.normal[d];
+    }
+    let (arm_a, arm_b) = (arm_to(a, touch.point), arm_to(b, touch.point));
+    let (va, vb) = (ma.velocity_at(arm_a), mb.velocity_at(arm_b));
+    let relative: Vec3 = std::array::from_fn(|d| va[d] - vb[d]);
+    let n = touch.normal;
+    let vn = dot(relative, n);
+    if vn >= 0.0 {
+        return;
+    }
+    let resistance = |u| ma.resistance(arm_a, u) + mb.resistance(arm_b, u);
+    let j = -(1.0 + a.restitution.max(b.restitution)) * vn / resistance(n);
+    let friction = (a.friction * b.friction).sqrt();
+    let sliding: Vec3 = std::array::from_fn(|d| relative[d] - vn * n[d]);
+    let speed = dot(sliding, sliding).sqrt();
+    let mut p = n.map(|c| j * c);
+    if speed > 0.0 && friction > 0.0 {
+        let t = sliding.map(|c| c / speed);
+        let jt = (speed / resistance(t)).min(friction * j);
+        for d in 0..3 {
+            p[d] -= jt * t[d];
+        }
+    }
+    ma.kick(arm_a, p);
+    mb.kick(arm_b, p.map(|c| -c));
+    for (body, motion, yields) in [(a, ma, free_a), (b, mb, free_b)] {
+        if yields {
+            body.state.velocity = motion.velocity;
+            body.state.angular_momentum = motion.angular_momentum;
+        }
+    }
 }
 
 /// Whether body b moves freely over the step from `time` (a fixed or prescribed body does not
 /// yield to a contact).
 fn moves_freely(body: &RigidBody, time: f64) -> bool {
     matches!(body.motion_at(time), BodyMotion::Free)
+}
+
+/// The unit vector along axis d with `sign`.
+fn axis(d: usize, sign: f64) -> Vec3 {
+    let mut n = [0.0; 3];
+    n[d] = sign;
+    n
+}
+
+fn arm_to(body: &RigidBody, point: Vec3) -> Vec3 {
+    std::array::from_fn(|d| point[d] - body.state.centre[d])
 }
 
 /// The positions of a body's particles now.
@@ -193,121 +450,4 @@ fn contact_patch(points: &[Vec3], depth: impl Fn(&Vec3) -> f64) -> Option<(Vec3,
         }
     }
     (weight > 0.0).then(|| (sum.map(|s| s / weight), deepest))
-}
-
-/// Pushes free body `a` off a surface that does not move (a container face, an obstacle) at
-/// `touch`, with the body's own restitution and friction.
-fn push_off_fixed(a: &mut RigidBody, touch: Touch, dims: usize) {
-    for d in 0..dims {
-        a.state.centre[d] += touch.depth * touch.normal[d];
-    }
-    let arm = arm_to(a, touch.point);
-    let relative = velocity_at(a, arm);
-    let j = impulse(
-        relative,
-        touch.normal,
-        [Some((a as &RigidBody, arm)), None],
-        a.restitution,
-        a.friction,
-    );
-    if let Some(j) = j {
-        kick(a, arm, j, 1.0);
-    }
-}
-
-/// Pushes bodies a and b apart at `touch` (its normal towards a); `free_a`, `free_b` whether
-/// each yields.
-fn push_apart(
-    a: &mut RigidBody,
-    free_a: bool,
-    b: &mut RigidBody,
-    free_b: bool,
-    touch: Touch,
-    dims: usize,
-) {
-    let (wa, wb) = (
-        if free_a { 1.0 / a.mass } else { 0.0 },
-        if free_b { 1.0 / b.mass } else { 0.0 },
-    );
-    for d in 0..dims {
-        a.state.centre[d] += touch.depth * wa / (wa + wb) * touch.normal[d];
-        b.state.centre[d] -= touch.depth * wb / (wa + wb) * touch.normal[d];
-    }
-    let (arm_a, arm_b) = (arm_to(a, touch.point), arm_to(b, touch.point));
-    let (va, vb) = (velocity_at(a, arm_a), velocity_at(b, arm_b));
-    let relative = std::array::from_fn(|d| va[d] - vb[d]);
-    let restitution = a.restitution.max(b.restitution);
-    let friction = (a.friction * b.friction).sqrt();
-    let sides = [
-        free_a.then_some((&*a, arm_a)),
-        free_b.then_some((&*b, arm_b)),
-    ];
-    if let Some(j) = impulse(relative, touch.normal, sides, restitution, friction) {
-        if free_a {
-            kick(a, arm_a, j, 1.0);
-        }
-        if free_b {
-            kick(b, arm_b, j, -1.0);
-        }
-    }
-}
-
-fn arm_to(body: &RigidBody, point: Vec3) -> Vec3 {
-    std::array::from_fn(|d| point[d] - body.state.centre[d])
-}
-
-fn velocity_at(body: &RigidBody, arm: Vec3) -> Vec3 {
-    super::rigid_velocity(body.state.velocity, body.angular_velocity(), arm)
-}
-
-/// The impulse on the first side of a contact with relative velocity `relative` (first less
-/// second) at the point, normal `n` towards the first: the normal impulse with restitution e
-/// and the Coulomb friction impulse, at most μ times it. `sides` are the bodies that yield with
-/// their arms to the point. None if they do not approach.
-fn impulse(
-    relative: Vec3,
-    n: Vec3,
-    sides: [Option<(&RigidBody, Vec3)>; 2],
-    restitution: f64,
-    friction: f64,
-) -> Option<Vec3> {
-    let vn = dot(relative, n);
-    if vn >= 0.0 {
-        return None;
-    }
-    let j = -(1.0 + restitution) * vn / resistance(&sides, n);
-    let sliding: Vec3 = std::array::from_fn(|d| relative[d] - vn * n[d]);
-    let speed = dot(sliding, sliding).sqrt();
-    let mut p = n.map(|c| j * c);
-    if speed > 0.0 && friction > 0.0 {
-        let t = sliding.map(|c| c / speed);
-        let jt = (speed / resistance(&sides, t)).min(friction * j);
-        for d in 0..3 {
-            p[d] -= jt * t[d];
-        }
-    }
-    Some(p)
-}
-
-/// 1/m_eff along direction `u` at the contact: Σ w + u·(I⁻¹(r × u) × r) over the yielding sides.
-fn resistance(sides: &[Option<(&RigidBody, Vec3)>; 2], u: Vec3) -> f64 {
-    sides
-        .iter()
-        .flatten()
-        .map(|(body, arm)| {
-            let r = body.rotation();
-            let inverse = rotation::to_world(&r, &rotation::inverse_on_span(&body.inertia));
-            let turn = cross(rotation::apply(&inverse, cross(*arm, u)), *arm);
-            1.0 / body.mass + dot(u, turn)
-        })
-        .sum()
-}
-
-/// Adds `sign` times the impulse `p` at `arm` to a body's momentum and angular momentum.
-fn kick(body: &mut RigidBody, arm: Vec3, p: Vec3, sign: f64) {
-    let turn = cross(arm, p);
-    for d in 0..3 {
-        body.state.velocity[d] += sign * p[d] / body.mass;
-        body.state.angular_momentum[d] += sign * turn[d];
-    }
 }
