@@ -318,7 +318,7 @@ density = 1000.0
     // water around it 3e-4 m/s).
     let bound = 1e-3 * (9.81f64 * 0.1).sqrt();
     for (t, r) in &rows {
-        let speed = (r[7] * r[7] + r[VY] * r[VY]).sqrt();
+        let speed = r[VX].hypot(r[VY]);
         assert!(
             speed < bound,
             "t = {t}: a neutral body moves at {speed} m/s (bound {bound})"
@@ -546,16 +546,16 @@ fn two_bodies_that_collide_bounce_by_their_restitution_and_keep_their_momentum()
         // Momentum: equal masses, equal and opposite velocities at every frame.
         for k in 0..=last {
             assert!(
-                (left[k].1[7] + right[k].1[7]).abs() < 1e-12,
+                (left[k].1[VX] + right[k].1[VX]).abs() < 1e-12,
                 "e = {restitution}, t = {}: vx {} and {}",
                 left[k].0,
-                left[k].1[7],
-                right[k].1[7]
+                left[k].1[VX],
+                right[k].1[VX]
             );
         }
         // They meet 0.15 s in (0.4 m apart less two radii at 2 m/s); after the impact the left
         // body moves at e times its speed, backwards.
-        let after = left[last].1[7];
+        let after = left[last].1[VX];
         assert!(
             (after - expected).abs() < 1e-9,
             "e = {restitution}: vx after the impact {after}, expected {expected}"
@@ -608,9 +608,9 @@ friction = 0.5
         "t = {t}: lowest particle at {lowest}"
     );
     assert!(
-        last[VY].abs() < 1e-9 && last[7].abs() < 1e-9,
+        last[VY].abs() < 1e-9 && last[VX].abs() < 1e-9,
         "t = {t}: still moving {:?}",
-        &last[7..9]
+        &last[VX..=VY]
     );
     assert!(last[12].abs() < 1e-9, "t = {t}: turning at {}", last[12]);
 }

@@ -188,21 +188,26 @@ impl Bodies {
     /// The container faces a body whose particles are at `points` comes closer to than `gap`,
     /// each with its contact.
     fn faces_touched(&self, points: &[Vec3], gap: f64) -> Vec<Touch> {
-        let mut touches = Vec::new();
-        for (d, face) in self.faces.iter().enumerate() {
-            let Some((lo, hi)) = *face else { continue };
-            for (plane, sign) in [(lo, 1.0), (hi, -1.0)] {
+        self.planes()
+            .filter_map(|(d, plane, sign)| {
                 let depth = |x: &Vec3| gap - sign * (x[d] - plane);
-                if let Some((point, depth)) = contact_patch(points, depth) {
-                    touches.push(Touch {
-                        point,
-                        normal: axis(d, sign),
-                        depth,
-                    });
-                }
-            }
-        }
-        touches
+                let (point, depth) = contact_patch(points, depth)?;
+                Some(Touch {
+                    point,
+                    normal: axis(d, sign),
+                    depth,
+                })
+            })
+            .collect()
+    }
+
+    /// The container's faces a body can touch: the axis d, the plane's coordinate along it
+    /// and the sign of its inward normal (+1 at the low face, −1 at the high one).
+    fn planes(&self) -> impl Iterator<Item = (usize, f64, f64)> + '_ {
+        self.faces.iter().enumerate().flat_map(|(d, face)| {
+            face.iter()
+                .flat_map(move |&(lo, hi)| [(d, lo, 1.0), (d, hi, -1.0)])
+        })
     }
 
     /// The deepest contact between bodies a and b, its normal pointing towards a.
@@ -246,12 +251,9 @@ impl Bodies {
         let near = gap + SLOP * self.spacing;
         let points = world_points(body);
         let mut found = Vec::new();
-        for (d, face) in self.faces.iter().enumerate() {
-            let Some((lo, hi)) = *face else { continue };
-            for (plane, sign) in [(lo, 1.0), (hi, -1.0)] {
-                for x in points.iter().filter(|x| sign * (x[d] - plane) < near) {
-                    found.push(ContactPoint::new(body, *x, axis(d, sign)));
-                }
+        for (d, plane, sign) in self.planes() {
+            for x in points.iter().filter(|x| sign * (x[d] - plane) < near) {
+                found.push(ContactPoint::new(body, *x, axis(d, sign)));
             }
         }
         for o in &self.obstacles {
@@ -315,13 +317,8 @@ fn solve_point(c: &mut ContactPoint, motion: &mut Motion, friction: f64) -> f64 
     if friction == 0.0 {
         return normal_change.abs();
     }
-    let relative = motion.velocity_at(c.arm);
-    let vn = dot(relative, n);
-    let sliding: Vec3 = std::array::from_fn(|d| relative[d] - vn * n[d]);
-    let speed = dot(sliding, sliding).sqrt();
     let mut tangent = c.tangent_impulse;
-    if speed > 0.0 {
-        let t = sliding.map(|s| s / speed);
+    if let Some((t, speed)) = sliding(motion.velocity_at(c.arm), n) {
         let stop = speed / motion.resistance(c.arm, t);
         for d in 0..3 {
             tangent[d] -= stop * t[d];
@@ -367,11 +364,8 @@ fn push_apart(
     let resistance = |u| ma.resistance(arm_a, u) + mb.resistance(arm_b, u);
     let j = -(1.0 + a.restitution.max(b.restitution)) * vn / resistance(n);
     let friction = (a.friction * b.friction).sqrt();
-    let sliding: Vec3 = std::array::from_fn(|d| relative[d] - vn * n[d]);
-    let speed = dot(sliding, sliding).sqrt();
     let mut p = n.map(|c| j * c);
-    if speed > 0.0 && friction > 0.0 {
-        let t = sliding.map(|c| c / speed);
+    if let Some((t, speed)) = sliding(relative, n).filter(|_| friction > 0.0) {
         let jt = (speed / resistance(t)).min(friction * j);
         for d in 0..3 {
             p[d] -= jt * t[d];
@@ -385,6 +379,15 @@ fn push_apart(
             body.state.angular_momentum = motion.angular_momentum;
         }
     }
+}
+
+/// The direction and the speed of the part of `relative` across the normal `n`: how the two
+/// sides of a contact slide on each other; None where they do not.
+fn sliding(relative: Vec3, n: Vec3) -> Option<(Vec3, f64)> {
+    let vn = dot(relative, n);
+    let across: Vec3 = std::array::from_fn(|d| relative[d] - vn * n[d]);
+    let speed = dot(across, across).sqrt();
+    (speed > 0.0).then(|| (across.map(|c| c / speed), speed))
 }
 
 /// Whether body b moves freely over the step from `time` (a fixed or prescribed body does not
