@@ -120,6 +120,7 @@ impl<const D: usize> Simulation<D> {
             CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
             interfaces,
             !bodies.is_empty(),
+            scene.bodies_differ_in_density(),
             scene
                 .container_motion
                 .clone()

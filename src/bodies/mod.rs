@@ -96,6 +96,10 @@ pub struct RigidBody {
     pub release: Option<f64>,
     /// M = Σ m_i [kg] (per metre of depth in 2D).
     pub mass: f64,
+    /// Each of its particles' mass m_i and rest density ρ0_i = m_i/V_i when it moves freely
+    /// (`Bodies::set_solve_densities`).
+    pub particle_mass: f64,
+    pub particle_density: f64,
     /// Inertia tensor about the centre of mass in the body's own frame [kg m²]; in 2D only
     /// the zz part, the polar moment of Eq. (13).
     pub inertia: Mat3,
@@ -214,6 +218,9 @@ pub struct Bodies {
     obstacles: Vec<Shape>,
     spacing: f64,
     dims: usize,
+    /// The first fluid's rest density, which a held body's particles take in the pressure
+    /// solve (`set_solve_densities`).
+    water_density: f64,
 }
 
 impl Bodies {
@@ -273,6 +280,8 @@ impl Bodies {
                     motion: body.motion.clone(),
                     release: body.release,
                     mass,
+                    particle_mass: p.mass[members[0]],
+                    particle_density: p.rest_density[members[0]],
                     inertia,
                     external_force: std::array::from_fn(|d| {
                         body.force.get(d).copied().unwrap_or(0.0)
@@ -318,11 +327,32 @@ impl Bodies {
                 .collect(),
             spacing: scene.spacing,
             dims: D,
+            water_density: scene.fluids[0].density,
         }
     }
 
     pub fn is_empty(&self) -> bool {
         self.bodies.is_empty()
+    }
+
+    /// Gives each body particle the mass and rest density the step from `time` takes it at:
+    /// its body's own where the body moves freely, the water's (the first fluid's) with the
+    /// same volume where it is held (fixed or prescribed). A held body's motion does not
+    /// depend on its mass, and at the water's density the pressure solve sees no interface at
+    /// its surface: the water's hydrostatic pressure runs through it as through the water,
+    /// whatever the body's density, and the fluid's force on it, −Σ V_i ∇P_i, is the same
+    /// (docs/bodies.md, "The coupling").
+    pub fn set_solve_densities<const D: usize>(&self, p: &mut Particles<D>, time: f64) {
+        for i in (0..p.len()).filter(|&i| p.kind[i] == Kind::Body) {
+            let body = &self.bodies[p.fluid[i] as usize];
+            (p.mass[i], p.rest_density[i]) = match body.motion_at(time) {
+                BodyMotion::Free => (body.particle_mass, body.particle_density),
+                BodyMotion::Fixed | BodyMotion::Prescribed(_) => {
+                    let volume = body.particle_mass / body.particle_density;
+                    (self.water_density * volume, self.water_density)
+                }
+            };
+        }
     }
 
     /// Gives the bodies' particles their bodies' rigid velocities (at t = 0).

@@ -252,11 +252,21 @@ impl Scene {
     /// weighted (`interface`).
     pub fn has_interfaces(&self) -> bool {
         let water = self.fluids[0].density;
-        self.fluids.iter().any(|f| f.density != water)
-            || self
-                .bodies
-                .iter()
-                .any(|b| b.mass != BodyMass::Density(water))
+        self.fluids.iter().any(|f| f.density != water) || self.bodies_differ_in_density()
+    }
+
+    /// Whether a body that moves freely at some time differs in rest density from a fluid:
+    /// its surface is then an interface of the pressure solve (`step::hydrostatic_split`). A
+    /// held body takes the water's density in the solve (`Bodies::set_solve_densities`).
+    pub fn bodies_differ_in_density(&self) -> bool {
+        self.bodies
+            .iter()
+            .filter(|b| b.motion == BodyMotion::Free || b.release.is_some())
+            .any(|b| {
+                self.fluids
+                    .iter()
+                    .any(|f| b.mass != BodyMass::Density(f.density))
+            })
     }
 
     /// A hash of everything in the validated scene that shapes the trajectory: xxh3-64 of its

@@ -33,6 +33,7 @@ mod density_correction;
 mod diagnostics;
 mod eddy_viscosity;
 mod free_surface;
+mod hydrostatic_split;
 mod interface_distance;
 mod kernel_correction;
 mod predictor;
@@ -173,6 +174,7 @@ pub struct Step<const D: usize> {
     eddy_viscosity: Option<eddy_viscosity::EddyViscosity>,
     body_forces: Option<body_forces::BodyForces<D>>,
     predictor: predictor::Predictor<D>,
+    hydrostatic_split: Option<hydrostatic_split::HydrostaticSplit<D>>,
     pressure_solve: pressure_solve::PressureSolve<D>,
     corrector: corrector::Corrector<D>,
     rigid_bodies: Option<rigid_bodies::RigidBodies>,
@@ -186,8 +188,9 @@ pub struct Step<const D: usize> {
 impl<const D: usize> Step<D> {
     /// The step of a scene with `settings`, on `grid`; `interfaces` is the kernel's table of
     /// distances to an interface where the fluids differ in rest density (None: one density);
-    /// `bodies` whether the scene has rigid bodies; `frame` the container's motion (None: at
-    /// rest).
+    /// `bodies` whether the scene has rigid bodies, `body_interfaces` whether some differ in
+    /// rest density from a fluid; `frame` the container's motion (None: at rest).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         settings: StepSettings<D>,
         kernel: Quintic<D>,
@@ -195,6 +198,7 @@ impl<const D: usize> Step<D> {
         grid: CellList<D>,
         interfaces: Option<Interfaces>,
         bodies: bool,
+        body_interfaces: bool,
         frame: Option<MovingFrame>,
     ) -> Self {
         let effects = &settings.effects;
@@ -210,6 +214,7 @@ impl<const D: usize> Step<D> {
             eddy_viscosity: effects.les.map(eddy_viscosity::EddyViscosity::new),
             body_forces: (bodies || frame.is_some()).then(|| body_forces::BodyForces::new(frame)),
             predictor: predictor::Predictor::default(),
+            hydrostatic_split: body_interfaces.then(hydrostatic_split::HydrostaticSplit::default),
             pressure_solve: pressure_solve::PressureSolve::new(settings.alpha > 0.0),
             corrector: corrector::Corrector::default(),
             rigid_bodies: bodies.then(rigid_bodies::RigidBodies::default),
@@ -244,11 +249,11 @@ impl<const D: usize> Step<D> {
         if let Some(s) = &self.body_forces {
             stages.push(s);
         }
-        stages.extend([
-            &self.predictor as &dyn Stage<D>,
-            &self.pressure_solve,
-            &self.corrector,
-        ]);
+        stages.push(&self.predictor);
+        if let Some(s) = &self.hydrostatic_split {
+            stages.push(s);
+        }
+        stages.extend([&self.pressure_solve as &dyn Stage<D>, &self.corrector]);
         if let Some(s) = &self.rigid_bodies {
             stages.push(s);
         }
@@ -302,6 +307,10 @@ impl<const D: usize> Step<D> {
     ) -> Result<StepReport, StepError> {
         let mut laps = Laps::new(timings);
         self.cell_list.run(p)?;
+        if self.rigid_bodies.is_some() {
+            // Into the particles: the bodies' particles' mass and rest density for the step.
+            bodies.set_solve_densities(p, time);
+        }
         laps.lap(cell_list::NAME);
         let (limit, _) = time_step::limiting(p, self.kernel.h(), &self.settings)?;
         let (length, lands_on_target) = time_step::length(limit, target - time);
@@ -345,6 +354,14 @@ impl<const D: usize> Step<D> {
                 .predictor
                 .run(&nb, p, set, eddy, set.body_force(force), dt, nf);
             laps.lap(predictor::NAME);
+            if let (Some(stage), Some(field), Some(force)) =
+                (&mut self.hydrostatic_split, interfaces, force)
+            {
+                let surface = self.free_surface.output();
+                stage.run(&nb, p, &surface, field, force, nf);
+                stage.apply(u_star, dt);
+                laps.lap(hydrostatic_split::NAME);
+            }
             let surface = &mut self.free_surface;
             let solve = self
                 .pressure_solve
