@@ -234,7 +234,7 @@ fn assert_box_draft_3d(dx: f64, until: f64, bound: f64) {
 
 #[test]
 fn a_3d_box_at_half_the_density_of_water_floats_at_half_its_height() {
-    // First order in the spacing: 5 particles in the draft here, −3.0% measured (docs/bodies.md,
+    // First order in the spacing: 5 particles in the draft here, −4.9% measured (docs/bodies.md,
     // "Archimedes"); `…_at_ten_particles_in_the_draft` holds the 3% asked at 10.
     assert_box_draft_3d(0.01, 1.0, 0.08);
 }
@@ -551,8 +551,8 @@ fn the_sinking_cylinder_keeps_near_the_band_of_its_two_references() {
     // scenes/sinking_cylinder_2d.toml (D/dx = 20): R = 1 m at s = 1.2 held half submerged for
     // 1 s, then let go. Its displacement at T = (t − 1) √(g/R) = 1 … 4 against Fekken (2004)
     // and Moyo & Greenhow (2000): inside their band widened by 10% of the nearer one (measured
-    // 3.0%, 6.2% and 0.5% beyond it at T = 1, 2, 3 and inside at T = 4; at D/dx = 40, 4.0%
-    // beyond at T = 2 and inside at T = 1, 3, 4: docs/bodies.md, "Sinking cylinder").
+    // 1.0% beyond it at T = 2 and inside at T = 1, 3, 4; at D/dx = 40, 1.2% beyond at T = 2
+    // and inside at T = 1, 3, 4: docs/bodies.md, "Sinking cylinder").
     let dir = TempDir::new("bodies-sinking-cylinder");
     let scene = crate::common::shipped_scene("sinking_cylinder_2d.toml");
     let release = 1.0;

@@ -27,6 +27,9 @@ use crate::math::vector::dot;
 use crate::particles::{Kind, Particles};
 use crate::scene::{BodyMotion, Scene};
 
+/// Rounds of `Bodies::keep_out` over the bodies for one fluid particle.
+const KEEP_OUT_ROUNDS: usize = 8;
+
 /// The lasting state of a rigid body.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidState {
@@ -451,9 +454,10 @@ impl Bodies {
     /// had crossed the surface (a penetration).
     pub fn keep_out(&self, x: &mut Vec3, u: &mut Vec3, gap: f64, dims: usize) -> (bool, bool) {
         let (mut moved, mut crossed) = (false, false);
-        // A second and third round for a particle put back off one body into another beside
-        // it (two bodies in contact); one squeezed between them stays where the last put it.
-        for _ in 0..3 {
+        // More rounds for a particle put back off one body into another beside it (two bodies
+        // in contact): put back off each in turn, it moves out of the crevice between them; one
+        // still squeezed after the last round stays where that put it.
+        for _ in 0..KEEP_OUT_ROUNDS {
             let mut again = false;
             for body in &self.bodies {
                 let s = &body.state;
