@@ -126,6 +126,9 @@ impl<const D: usize> Stage<D> for HydrostaticSplit<D> {
     }
 
     fn arrays(&self) -> Vec<ArraySize> {
-        vec![ArraySize::of("body flag", &self.body)]
+        vec![
+            ArraySize::of("body flag", &self.body),
+            ArraySize::sparse("accelerations beside the bodies", &self.acceleration),
+        ]
     }
 }
