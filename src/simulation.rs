@@ -6,7 +6,7 @@ use crate::boundary::faces::Faces;
 use crate::boundary::moving_frame::MovingFrame;
 use crate::fill;
 use crate::io::stats::StepStats;
-use crate::math::kernel::{Quintic, SUPPORT_IN_H};
+use crate::math::kernel::Kernel;
 use crate::math::memory::ArraySize;
 use crate::neighbours::cell_list::CellList;
 use crate::particles::Particles;
@@ -83,7 +83,6 @@ impl<const D: usize> Simulation<D> {
         let confined = fill::fills_container(scene, &particles);
         let bodies = Bodies::new(scene, &particles);
         bodies.set_particle_velocities(&mut particles);
-        let h = scene.smoothing_length();
         // Bounded axes: room for the wall layers and a spacing more; a periodic axis is one
         // period, the container's extent.
         let periodic: [bool; D] = std::array::from_fn(|d| scene.periodic[d]);
@@ -102,14 +101,18 @@ impl<const D: usize> Simulation<D> {
             },
             effects: scene.effects,
             confined,
-            spray_density: free_surface::spray_density::<D>(scene.solver.h_over_dx),
+            spray_density: free_surface::spray_density::<D>(
+                scene.solver.kernel,
+                scene.solver.h_over_dx,
+            ),
             min_correction_determinant: sph::min_correction_determinant::<D>(
+                scene.solver.kernel,
                 scene.solver.h_over_dx,
             ),
             cfl: scene.solver.cfl,
             max_viscosity: scene.fluids.iter().map(|f| f.viscosity).fold(0.0, f64::max),
         };
-        let kernel = Quintic::new(h);
+        let kernel = Kernel::new(scene.solver.kernel, scene.spacing, scene.solver.h_over_dx);
         let interfaces = scene
             .has_interfaces()
             .then(|| Interfaces::new(&kernel, scene.spacing));
@@ -117,7 +120,7 @@ impl<const D: usize> Simulation<D> {
             settings,
             kernel,
             Faces::new(&scene.container, &scene.periodic, &scene.obstacles),
-            CellList::new(lo, hi, SUPPORT_IN_H * h, periodic),
+            CellList::new(lo, hi, kernel.support(), periodic),
             interfaces,
             !bodies.is_empty(),
             scene.bodies_differ_in_density(),
@@ -142,7 +145,7 @@ impl<const D: usize> Simulation<D> {
         })
     }
 
-    pub fn kernel(&self) -> Quintic<D> {
+    pub fn kernel(&self) -> Kernel<D> {
         self.stepper.kernel()
     }
 
@@ -154,8 +157,12 @@ impl<const D: usize> Simulation<D> {
     /// Largest stable Δt of the particles as they are, and the condition that sets it
     /// (`time_step::limiting`).
     pub fn time_step_limit(&self) -> Result<(f64, Limit), NumericalFailure> {
-        time_step::limiting(&self.particles, self.kernel().h(), &self.stepper.settings)
-            .map_err(|e| self.failure(e))
+        time_step::limiting(
+            &self.particles,
+            self.kernel().width(),
+            &self.stepper.settings,
+        )
+        .map_err(|e| self.failure(e))
     }
 
     /// Advances by one step towards the simulated time `target` (the next frame's), landing on

@@ -187,6 +187,25 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             "max = [0.4, 0.3]\n\n[[probe]]\nname = \"a,b\"\npoint = [0.1, 0.1]\nfield = \"pressure\"",
             &["probe[0].name", "scene.toml:23", "plain column name"],
         ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[solver]\nkernel = \"cubic\"",
+            &[
+                "solver.kernel",
+                "scene.toml:23",
+                "\"cubic\" is not a kernel",
+                "quintic, wendland_c2, wendland_c4",
+            ],
+        ),
+        (
+            "max = [0.4, 0.3]",
+            "max = [0.4, 0.3]\n\n[solver]\nkernel = \"wendland_c2\"\nh_over_dx = 3.5",
+            &[
+                "solver.h_over_dx",
+                "scene.toml:24",
+                "[1.0, 3.0] with the wendland_c2 kernel",
+            ],
+        ),
     ];
     for (from, to, expected) in cases {
         let (code, stderr) = run_text(dir.path(), &good().replace(from, to), &[]);

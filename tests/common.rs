@@ -1,6 +1,6 @@
 //! Shared helpers: lattices of particles sorted into a cell list, scenes, and runs.
 
-use isph::math::kernel::{Quintic, SUPPORT_IN_H};
+use isph::math::kernel::{Kernel, KernelKind};
 use isph::neighbours::cell_list::CellList;
 use isph::particles::{Kind, NewParticle, Particles};
 use isph::run::{run, RunOptions, RunSummary};
@@ -13,7 +13,7 @@ use std::process::Command;
 pub struct Lattice<const D: usize> {
     pub particles: Particles<D>,
     pub grid: CellList<D>,
-    pub kernel: Quintic<D>,
+    pub kernel: Kernel<D>,
 }
 
 impl<const D: usize> Lattice<D> {
@@ -21,11 +21,22 @@ impl<const D: usize> Lattice<D> {
         Self::part(n, dx, h_over_dx, |_| true)
     }
 
+    /// `new` with the kernel `kind`.
+    pub fn with_kernel(kind: KernelKind, n: i64, dx: f64, h_over_dx: f64) -> Self {
+        Self::build(Self::block(n), dx, Kernel::new(kind, dx, h_over_dx))
+    }
+
     /// The points of `new` whose lattice index `keep` accepts.
     pub fn part(n: i64, dx: f64, h_over_dx: f64, keep: impl Fn(&[i64; D]) -> bool) -> Self {
+        let points = Self::block(n).filter(|(index, _)| keep(index));
+        Self::from_indices(points, dx, h_over_dx)
+    }
+
+    /// The lattice indices of `new`, fluid.
+    fn block(n: i64) -> impl Iterator<Item = ([i64; D], Kind)> {
         let half = n / 2;
         let total = (n as usize).pow(D as u32);
-        let points = (0..total).map(|k| {
+        (0..total).map(move |k| {
             let mut rest = k as i64;
             let index = std::array::from_fn(|_| {
                 let c = rest % n;
@@ -33,8 +44,7 @@ impl<const D: usize> Lattice<D> {
                 c - half
             });
             (index, Kind::Fluid)
-        });
-        Self::from_indices(points.filter(|(index, _)| keep(index)), dx, h_over_dx)
+        })
     }
 
     /// Particles at lattice indices (position = index · dx) of the given kinds.
@@ -42,6 +52,15 @@ impl<const D: usize> Lattice<D> {
         points: impl IntoIterator<Item = ([i64; D], Kind)>,
         dx: f64,
         h_over_dx: f64,
+    ) -> Self {
+        Self::build(points, dx, Kernel::new(KernelKind::Quintic, dx, h_over_dx))
+    }
+
+    /// Particles at lattice indices of the given kinds, with `kernel`.
+    fn build(
+        points: impl IntoIterator<Item = ([i64; D], Kind)>,
+        dx: f64,
+        kernel: Kernel<D>,
     ) -> Self {
         let mut particles = Particles::<D>::default();
         let mut extent = 0.0_f64;
@@ -58,14 +77,8 @@ impl<const D: usize> Lattice<D> {
                 viscosity: 0.0,
             });
         }
-        let kernel = Quintic::<D>::new(h_over_dx * dx);
         let extent = extent + 2.0 * dx;
-        let mut grid = CellList::new(
-            [-extent; D],
-            [extent; D],
-            SUPPORT_IN_H * kernel.h(),
-            [false; D],
-        );
+        let mut grid = CellList::new([-extent; D], [extent; D], kernel.support(), [false; D]);
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
         grid.sort(&particles.pos, &particles.kind, &mut cells, &mut order)
             .expect("lattice inside grid");

@@ -2,6 +2,7 @@
 //! in 2D and 3D: exactly the particles on the outside of the fluid take P = 0.
 
 use crate::common::Lattice;
+use isph::math::kernel::KernelKind;
 use isph::neighbours::Neighbours;
 use isph::particles::Kind;
 use isph::sph::free_surface::{spray_density, Support};
@@ -14,7 +15,7 @@ const H_OVER_DX: f64 = 1.2;
 fn detect<const D: usize>(lat: &Lattice<D>) -> Vec<([i64; D], bool)> {
     let p = &lat.particles;
     let nb = Neighbours::new(&lat.grid, &p.pos, lat.kernel);
-    let spray = spray_density::<D>(lat.kernel.h() / DX);
+    let spray = spray_density::<D>(lat.kernel.kind(), lat.kernel.h() / DX);
     (0..p.len())
         .filter(|&i| p.is_fluid(i))
         .map(|i| {
@@ -81,12 +82,12 @@ fn the_outer_layer_only_at_every_smoothing_length() {
 
 #[test]
 fn the_spray_density_is_0_9_where_it_was_set_and_falls_with_the_kernel_s_reach() {
-    assert_eq!(spray_density::<2>(1.2), 0.9);
-    assert_eq!(spray_density::<3>(1.2), 0.9);
+    assert_eq!(spray_density::<2>(KernelKind::Quintic, 1.2), 0.9);
+    assert_eq!(spray_density::<3>(KernelKind::Quintic, 1.2), 0.9);
     // 0.9 × the second-layer corner's lattice density over its value at h/dx = 1.2.
-    let d = spray_density::<2>(2.0);
+    let d = spray_density::<2>(KernelKind::Quintic, 2.0);
     assert!((d - 0.9 * 0.740 / 0.947).abs() < 0.003, "{d}");
-    let d = spray_density::<3>(2.0);
+    let d = spray_density::<3>(KernelKind::Quintic, 2.0);
     assert!((d - 0.9 * 0.645 / 0.928).abs() < 0.003, "{d}");
 }
 

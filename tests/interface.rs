@@ -3,6 +3,7 @@
 
 use crate::common::Lattice;
 use isph::boundary::faces::Faces;
+use isph::math::kernel::{Kernel, KernelKind};
 use isph::math::lanes::F64s;
 use isph::math::vector::unit;
 use isph::neighbours::Neighbours;
@@ -144,7 +145,7 @@ fn the_distance_to_a_flat_interface_is_read_off_the_kernel() {
 
 #[test]
 fn far_from_any_other_fluid_the_distance_is_the_support_and_inside_it_zero() {
-    let table = Interfaces::new(&isph::math::kernel::Quintic::<3>::new(0.012), 0.01);
+    let table = Interfaces::new(&Kernel::<3>::new(KernelKind::Quintic, 0.01, 1.2), 0.01);
     assert!((table.distance(0.0) - 0.036).abs() < 1e-15);
     assert!(table.distance(0.5) < 1e-4 * 0.012);
     assert_eq!(table.distance(0.8), 0.0);

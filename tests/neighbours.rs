@@ -1,6 +1,6 @@
 //! The cell-list pair loop against a brute-force O(N²) search (its slow, obvious twin).
 
-use isph::math::kernel::{Quintic, SUPPORT_IN_H};
+use isph::math::kernel::{Kernel, KernelKind};
 use isph::neighbours::cell_list::{CellList, KINDS};
 use isph::neighbours::Neighbours;
 use isph::particles::{Kind, NewParticle, Particles};
@@ -31,8 +31,8 @@ fn check<const D: usize>(n: usize, h: f64, periodic: [bool; D], size: f64) {
             viscosity: 0.0,
         });
     }
-    let kernel = Quintic::<D>::new(h);
-    let mut grid = CellList::new([0.0; D], [size; D], SUPPORT_IN_H * kernel.h(), periodic);
+    let kernel = Kernel::<D>::new(KernelKind::Quintic, 1.0, h);
+    let mut grid = CellList::new([0.0; D], [size; D], kernel.support(), periodic);
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
     grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);

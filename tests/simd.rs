@@ -3,7 +3,7 @@
 //! disordered block of fluid over a floor of wall particles, in 2D and 3D.
 
 use isph::boundary::ghosts::BodyForce;
-use isph::math::kernel::{Quintic, SUPPORT_IN_H};
+use isph::math::kernel::{Kernel, KernelKind};
 use isph::neighbours::cell_list::CellList;
 use isph::neighbours::Neighbours;
 use isph::particles::{Kind, NewParticle, Particles};
@@ -25,7 +25,7 @@ fn lcg(state: &mut u64) -> f64 {
 
 /// n^D fluid particles on a lattice moved by up to ±0.3 dx each, above four layers of wall
 /// particles (normal +y), sorted by kind and cell.
-fn disordered_block<const D: usize>(n: i64) -> (Particles<D>, CellList<D>, Quintic<D>) {
+fn disordered_block<const D: usize>(n: i64) -> (Particles<D>, CellList<D>, Kernel<D>) {
     let mut seed = 7;
     let mut p = Particles::<D>::default();
     let total = (n as usize).pow(D as u32);
@@ -58,9 +58,9 @@ fn disordered_block<const D: usize>(n: i64) -> (Particles<D>, CellList<D>, Quint
             viscosity: 1e-6,
         });
     }
-    let kernel = Quintic::<D>::new(H_OVER_DX * DX);
+    let kernel = Kernel::<D>::new(KernelKind::Quintic, DX, H_OVER_DX);
     let extent = n as f64 * DX;
-    let mut grid = CellList::new([-DX; D], [extent; D], SUPPORT_IN_H * kernel.h(), [false; D]);
+    let mut grid = CellList::new([-DX; D], [extent; D], kernel.support(), [false; D]);
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
     grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);
@@ -70,7 +70,7 @@ fn disordered_block<const D: usize>(n: i64) -> (Particles<D>, CellList<D>, Quint
 /// Every j ≠ i within the support of i, by brute force, with r_ij and |r_ij|.
 fn pairs<const D: usize>(
     p: &Particles<D>,
-    kernel: &Quintic<D>,
+    kernel: &Kernel<D>,
     i: usize,
 ) -> Vec<(usize, [f64; D], f64)> {
     (0..p.len())

@@ -20,8 +20,11 @@ from peers_report import isph_fields, parse
 
 
 def row(round_, code, setting, f):
-    print(",".join([round_, code, '"%s"' % setting, str(f["steps"]), str(f["iterations_mean"]),
-                    str(f["wall_per_sim_second"]), str(f["compression_mean"])]))
+    # The csv module quotes the setting, and doubles the quotes of a string key inside it
+    # (kernel = "wendland_c2").
+    csv.writer(sys.stdout, lineterminator="\n").writerow(
+        [round_, code, setting, f["steps"], f["iterations_mean"], f["wall_per_sim_second"],
+         f["compression_mean"]])
 
 
 def summary(path, png):

@@ -7,8 +7,8 @@
 # tools/peers_curves.py prints the medians and draws $WORK/curves.png.
 #
 # Usage: tools/peers_curves_3d.sh [SPACING=0.02] [UNTIL=0.6] [THREADS=2] [ROUNDS=3]
-# Environment: ISPH_SETTINGS (isph's settings, '|' between settings, ';' between the keys of
-# one; default "cfl = 0.24|cfl = 0.4|cfl = 0.6|cfl = 0.4; tolerance = 1e-3|cfl = 0.6; tolerance = 1e-3"),
+# Environment: ISPH_SETTINGS (isph's [solver] settings, '|' between settings, ';' between the
+# keys of one, e.g. 'kernel = "wendland_c2"; h_over_dx = 1.8'; default "cfl = 0.24|cfl = 0.4|cfl = 0.6|cfl = 0.4; tolerance = 1e-3|cfl = 0.6; tolerance = 1e-3"),
 # MAXERRORS (SPlisHSPlasH's density tolerances in percent; default "0.01 0.1 1"), SOLVERS
 # (default "DFSPH IISPH"), ISPH, WORK (default /tmp/isph_peers_curves_3d), SPLASH_VENV.
 set -euo pipefail

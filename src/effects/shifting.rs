@@ -53,8 +53,8 @@ impl Shifting {
         dt: f64,
     ) -> Self {
         Self {
-            diffusion: (settings.coefficient * nb.kernel.h() * max_speed * dt)
-                .min(MAX_DIFFUSION_NUMBER * nb.kernel.h() * nb.kernel.h()),
+            diffusion: (settings.coefficient * nb.kernel.width() * max_speed * dt)
+                .min(MAX_DIFFUSION_NUMBER * nb.kernel.width() * nb.kernel.width()),
             w_dx: nb.kernel.w(spacing),
             cap: settings.max_shift * spacing,
             clustering_weight: settings.clustering_weight,

@@ -1,5 +1,5 @@
 //! The mathematics every layer shares, which knows nothing of particles or scenes: small
-//! vectors, SIMD lanes, thread-count-independent parallel loops and sums, the kernel of Eq. (19),
+//! vectors, SIMD lanes, thread-count-independent parallel loops and sums, the kernels (Eq. (19) and Wendland's),
 //! the walk over lattice points, the sizes of arrays, rotations and the shapes of bodies.
 
 pub(crate) mod aabb;

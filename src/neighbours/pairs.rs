@@ -9,7 +9,7 @@
 //! `for_each` offers the same walk one neighbour at a time, for the operators that run once per
 //! step; the hot loops (the PPE apply, density, …) work on the lanes directly.
 
-use crate::math::kernel::Quintic;
+use crate::math::kernel::Kernel;
 use crate::math::lanes::{F64s, LANES};
 use crate::neighbours::cell_list::{CellList, KINDS};
 use crate::particles::Kind;
@@ -81,7 +81,7 @@ fn load(a: &[f64], j0: usize, fill: f64) -> F64s {
 pub struct Neighbours<'a, const D: usize> {
     grid: &'a CellList<D>,
     pos: &'a [Vec<f64>; D],
-    pub kernel: Quintic<D>,
+    pub kernel: Kernel<D>,
     support2: f64,
     eta2: f64,
     /// F(0) = W''(0).
@@ -89,7 +89,7 @@ pub struct Neighbours<'a, const D: usize> {
 }
 
 impl<'a, const D: usize> Neighbours<'a, D> {
-    pub fn new(grid: &'a CellList<D>, pos: &'a [Vec<f64>; D], kernel: Quintic<D>) -> Self {
+    pub fn new(grid: &'a CellList<D>, pos: &'a [Vec<f64>; D], kernel: Kernel<D>) -> Self {
         let support2 = kernel.support() * kernel.support();
         let eta2 = ETA2_IN_H2 * kernel.h() * kernel.h();
         Self {

@@ -1,7 +1,7 @@
 //! The scene file as TOML sections (serde), unknown keys rejected; `validate` turns it into a
 //! `Scene`.
 
-use super::{Fluid, SolverSettings, WallSettings};
+use super::{Fluid, WallSettings};
 use serde::Deserialize;
 
 #[derive(Debug, Clone, Deserialize)]
@@ -17,7 +17,7 @@ pub(super) struct SceneFile {
     pub(super) obstacle: Vec<BoxSection>,
     pub(super) initial_velocity: Option<InitialVelocitySection>,
     #[serde(default)]
-    pub(super) solver: SolverSettings,
+    pub(super) solver: SolverSection,
     #[serde(default)]
     pub(super) checkpoint: CheckpointSection,
     #[serde(default)]
@@ -30,6 +30,19 @@ pub(super) struct SceneFile {
     pub(super) probe: Vec<ProbeSection>,
     #[serde(default)]
     pub(super) body: Vec<BodySection>,
+}
+
+/// `[solver]` as written; `validate` fills what it leaves out from `SolverSettings::default`
+/// and the kernel's h/dx.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SolverSection {
+    pub(super) tolerance: Option<f64>,
+    pub(super) max_iterations: Option<usize>,
+    pub(super) alpha: Option<f64>,
+    pub(super) cfl: Option<f64>,
+    pub(super) kernel: Option<String>,
+    pub(super) h_over_dx: Option<f64>,
 }
 
 /// `[[body]]` as written: the keys of every shape and motion, each optional here; `validate`

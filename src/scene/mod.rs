@@ -16,7 +16,7 @@ pub use probes::{Probe, ProbeField};
 pub use surface::{CubeRule, SurfaceKernel, SurfaceRequest, SurfaceSettings};
 
 pub use crate::math::aabb::Aabb;
-use crate::math::kernel::SUPPORT_IN_H;
+use crate::math::kernel::KernelKind;
 use crate::math::mesh::TriangleMesh;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -74,9 +74,8 @@ impl InitialVelocity {
     }
 }
 
-/// The `[solver]` section: pressure solve, relaxation and time step.
-#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
+/// The `[solver]` section: pressure solve, relaxation, time step and kernel.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverSettings {
     /// Relative residual ‖b − Ax‖/‖b‖ at which BiCGSTAB stops.
     pub tolerance: f64,
@@ -85,7 +84,10 @@ pub struct SolverSettings {
     pub alpha: f64,
     /// Courant number C of Δt ≤ C dx / |u|max, on the particle spacing as the peers define it.
     pub cfl: f64,
-    /// Smoothing length over particle spacing, h/dx.
+    /// The smoothing kernel.
+    pub kernel: KernelKind,
+    /// Smoothing length over particle spacing, h/dx (the kernel's default unless the scene sets
+    /// it).
     pub h_over_dx: f64,
 }
 
@@ -96,7 +98,8 @@ impl Default for SolverSettings {
             max_iterations: 1000,
             alpha: 0.1,
             cfl: 0.4,
-            h_over_dx: 1.2,
+            kernel: KernelKind::Quintic,
+            h_over_dx: KernelKind::Quintic.default_h_over_dx(),
         }
     }
 }
@@ -215,9 +218,14 @@ impl Scene {
         validate::Validator { text, path }.scene(file)
     }
 
-    /// Number of dummy wall layers that fill the kernel support 3h.
+    /// Number of dummy wall layers that fill the kernel support.
     pub fn wall_layers(&self) -> usize {
-        (SUPPORT_IN_H * self.solver.h_over_dx - 1e-9).ceil() as usize
+        (self.support_in_dx() - 1e-9).ceil() as usize
+    }
+
+    /// The kernel support radius, in spacings.
+    pub fn support_in_dx(&self) -> f64 {
+        self.solver.kernel.support_in_h() * self.solver.h_over_dx
     }
 
     /// At least as many particles as `fill::build` makes, fluid and wall, counted without making

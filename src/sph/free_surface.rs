@@ -10,10 +10,11 @@
 //! 2. In between, the scan region decides: i is at the free surface exactly when no particle
 //!    (fluid or wall) lies in the umbrella beyond it along some direction n — the cone of
 //!    half-angle 45° around n within √2 h of r_i, capped by the ball of radius h around
-//!    r_i + h n. Marrone et al. scan along the normal n_i = −∇C_i/|∇C_i|, ∇C_i = Σ_j V_j ∇W_ij;
-//!    that normal misleads where walls fill one side (at the tip of a surge on the floor it
-//!    points up while the fluid is missing ahead), so the scan also runs both ways along the
-//!    eigenvector of λ_i, the direction in which the support is emptiest. A particle inside a
+//!    r_i + h n (h the kernel's `width`). Marrone et al. scan along the normal
+//!    n_i = −∇C_i/|∇C_i|, ∇C_i = Σ_j V_j ∇W_ij; that normal misleads where walls fill one
+//!    side (at the tip of a surge on the floor it points up while the fluid is missing ahead),
+//!    so the scan also runs both ways along the eigenvector of λ_i, the direction in which the
+//!    support is emptiest. A particle inside a
 //!    gap of the fluid or squeezed against a wall has a neighbour in every umbrella; one on
 //!    the surface has none in at least one.
 //! 3. A particle whose summation density is below 0.9 ρ0 (at h/dx = 1.2, scaled with the kernel's
@@ -29,7 +30,7 @@
 //!    otherwise answer with a pressure spike that shoots it out ahead of the front
 //!    (docs/stabilisation.md, "Compressed fluid is never free surface").
 
-use crate::math::kernel::Quintic;
+use crate::math::kernel::{Kernel, KernelKind};
 use crate::math::lattice::for_each_lattice_point;
 use crate::math::vector::{dot, norm};
 use crate::neighbours::Neighbours;
@@ -54,16 +55,16 @@ const SPRAY_H_OVER_DX: f64 = 1.2;
 /// 3D (0.99, 0.95, 0.87, 0.74 in 2D), so a fixed 0.9 would take it, and from h/dx ≈ 1.75 on a
 /// whole flat second row, for spray, fix their pressure at the surface's and let the water's
 /// top fall (docs/accuracy.md, "Smoothing length above 1.5: still water").
-pub fn spray_density<const D: usize>(h_over_dx: f64) -> f64 {
+pub fn spray_density<const D: usize>(kernel: KernelKind, h_over_dx: f64) -> f64 {
     SPRAY_DENSITY
-        * (second_corner_density::<D>(h_over_dx) / second_corner_density::<D>(SPRAY_H_OVER_DX))
+        * (second_corner_density::<D>(Kernel::new(kernel, 1.0, h_over_dx))
+            / second_corner_density::<D>(Kernel::new(KernelKind::Quintic, 1.0, SPRAY_H_OVER_DX)))
 }
 
 /// Σ_j W_ij dx^D at the corner of the second layer of a block filling the negative quadrant
 /// (octant) of a lattice of unit spacing: the lattice points at most one spacing from it
 /// along every axis towards the outside.
-fn second_corner_density<const D: usize>(h_over_dx: f64) -> f64 {
-    let kernel = Quintic::<D>::new(h_over_dx);
+fn second_corner_density<const D: usize>(kernel: Kernel<D>) -> f64 {
     let reach = kernel.support().ceil() as i64;
     let mut sum = 0.0;
     for_each_lattice_point([-reach; D], [reach + 1; D], |k| {
@@ -72,7 +73,7 @@ fn second_corner_density<const D: usize>(h_over_dx: f64) -> f64 {
             sum += kernel.w(norm(offset));
         }
     });
-    sum
+    sum * kernel.density_scale()
 }
 
 /// How the neighbours fill the kernel support of a fluid particle.
@@ -134,7 +135,7 @@ impl<const D: usize> Support<D> {
             return false;
         }
         let directions = [self.normal, self.axis, self.axis.map(|v| -v)];
-        let h = nb.kernel.h();
+        let h = nb.kernel.width();
         let mut covered = [false; 3];
         nb.for_each(i, |_, rij, r| {
             for (n, covered) in directions.iter().zip(&mut covered) {

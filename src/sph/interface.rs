@@ -15,14 +15,14 @@
 //! other half of the weighting). f comes from each particle's distance to the interface d_i
 //! (`Interfaces::distance`) and its normal across it (`other_fluid_share`): `pair_weight`.
 
-use crate::math::kernel::Quintic;
+use crate::math::kernel::Kernel;
 use crate::math::lanes::F64s;
 use crate::math::lattice::for_each_lattice_point;
 use crate::math::vector::norm;
 use crate::neighbours::{Lanes, Neighbours};
 use crate::particles::{Kind, Particles};
 
-/// Intervals of the table of `Interfaces` over [0, 3h].
+/// Intervals of the table of `Interfaces` over the kernel support.
 const TABLE_INTERVALS: usize = 600;
 
 /// The fraction of a particle's kernel mass that a lattice of the particle spacing beyond a
@@ -34,15 +34,15 @@ const TABLE_INTERVALS: usize = 600;
 /// (a continuum's half space read 0.53, 1.60, 2.73 spacings in 2D).
 #[derive(Clone, Debug)]
 pub struct Interfaces {
-    /// Fraction of the kernel's mass beyond a plane at distance s_k = 3h k/TABLE_INTERVALS,
+    /// Fraction of the kernel's mass beyond a plane at distance s_k = support × k/TABLE_INTERVALS,
     /// about ½ at k = 0, falling to 0 half a spacing short of the support radius.
     beyond: Vec<f64>,
-    /// 3h/TABLE_INTERVALS.
+    /// The support over TABLE_INTERVALS.
     step: f64,
 }
 
 impl Interfaces {
-    pub fn new<const D: usize>(kernel: &Quintic<D>, spacing: f64) -> Self {
+    pub fn new<const D: usize>(kernel: &Kernel<D>, spacing: f64) -> Self {
         let support = kernel.support();
         let step = support / TABLE_INTERVALS as f64;
         let reach = (support / spacing).ceil() as i64;

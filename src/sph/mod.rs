@@ -6,7 +6,7 @@ pub mod interface;
 pub mod probe;
 
 use crate::boundary::ghosts::{self, behind_walls, ghost_velocity, Face};
-use crate::math::kernel::Quintic;
+use crate::math::kernel::{Kernel, KernelKind};
 use crate::math::lanes::{F64s, Sum};
 use crate::math::lattice::for_each_lattice_point;
 use crate::neighbours::Lanes;
@@ -17,14 +17,14 @@ use crate::particles::{Kind, Particles};
 /// familiar Σ_j m_j W_ij where the support holds one fluid, while across the interface of two
 /// fluids each neighbour counts with its volume (Hu & Adams 2006), so that water beside oil is not
 /// taken for expanded (below 0.9 ρ0 it would be spray: `free_surface::spray_density`) nor the oil
-/// for compressed.
+/// for compressed. The kernel's `density_scale` makes it ρ0 on the rest lattice.
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
     let mut rho = Sum::ZERO;
     let rho0_i = F64s::splat(p.rest_density[i]);
     nb.for_each_lanes(i, |l| {
         rho += (mass_at_density(p, rho0_i, l) * nb.kernel.w_lanes(l.r)) & l.mask;
     });
-    p.mass[i] * nb.kernel.w(0.0) + rho.total()
+    (p.mass[i] * nb.kernel.w(0.0) + rho.total()) * nb.kernel.density_scale()
 }
 
 /// m_j ρ0_i/ρ0_j = ρ0_i V_j of the lanes: the mass of neighbour j's volume at particle i's rest
@@ -150,18 +150,21 @@ const CORRECTION_H_OVER_DX: f64 = 1.2;
 /// corners of still water in a 3D tank fall (`tests/hydrostatic.rs`,
 /// `still_water_in_a_3d_tank_stays_still_with_a_wide_kernel`; docs/accuracy.md, "Smoothing
 /// length above 1.5: still water").
-pub fn min_correction_determinant<const D: usize>(h_over_dx: f64) -> f64 {
+pub fn min_correction_determinant<const D: usize>(kernel: KernelKind, h_over_dx: f64) -> f64 {
     MIN_CORRECTION_DETERMINANT
-        * (wall_corner_determinant::<D>(h_over_dx)
-            / wall_corner_determinant::<D>(CORRECTION_H_OVER_DX))
+        * (wall_corner_determinant::<D>(Kernel::new(kernel, 1.0, h_over_dx))
+            / wall_corner_determinant::<D>(Kernel::new(
+                KernelKind::Quintic,
+                1.0,
+                CORRECTION_H_OVER_DX,
+            )))
 }
 
 /// det M'_i at the top of the water in the corner of the walls, on a lattice of unit spacing:
 /// the particle at the origin, fluid where no index is positive, the walls where one of the
 /// first D − 1 indices is (at every height; each counts the offset along the axes it lies
 /// behind, `ghosts::behind_walls`), air above the water.
-fn wall_corner_determinant<const D: usize>(h_over_dx: f64) -> f64 {
-    let kernel = Quintic::<D>::new(h_over_dx);
+fn wall_corner_determinant<const D: usize>(kernel: Kernel<D>) -> f64 {
     let reach = kernel.support().ceil() as i64;
     let mut m = [[0.0; D]; D];
     for_each_lattice_point([-reach; D], [reach + 1; D], |k| {

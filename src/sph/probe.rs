@@ -12,7 +12,7 @@
 //! bits for any thread count, and a few operations per particle per probe, against hundreds
 //! per particle in a step's pair loops.
 
-use crate::math::kernel::Quintic;
+use crate::math::kernel::Kernel;
 use crate::math::reduce;
 use crate::particles::Particles;
 
@@ -28,7 +28,7 @@ pub struct Sample<const D: usize> {
 /// length of the box along a periodic axis d: distances along it are to the nearest image.
 pub fn sample<const D: usize>(
     p: &Particles<D>,
-    kernel: &Quintic<D>,
+    kernel: &Kernel<D>,
     periods: &[Option<f64>; D],
     x: [f64; D],
 ) -> Sample<D> {

@@ -48,7 +48,7 @@ use crate::bodies::Bodies;
 use crate::boundary::faces::Faces;
 use crate::boundary::ghosts::{self, BodyForce};
 use crate::boundary::moving_frame::MovingFrame;
-use crate::math::kernel::Quintic;
+use crate::math::kernel::Kernel;
 use crate::math::memory::{ArraySize, Holds};
 use crate::math::reduce::fill;
 use crate::neighbours::cell_list::CellList;
@@ -165,7 +165,7 @@ pub trait Stage<const D: usize> {
 /// The stages of a step and their arrays: scratch, rebuilt from the particles each step.
 pub struct Step<const D: usize> {
     pub settings: StepSettings<D>,
-    kernel: Quintic<D>,
+    kernel: Kernel<D>,
     faces: Faces,
     cell_list: cell_list::CellSort<D>,
     density: density::Density<D>,
@@ -193,7 +193,7 @@ impl<const D: usize> Step<D> {
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         settings: StepSettings<D>,
-        kernel: Quintic<D>,
+        kernel: Kernel<D>,
         faces: Faces,
         grid: CellList<D>,
         interfaces: Option<Interfaces>,
@@ -228,7 +228,7 @@ impl<const D: usize> Step<D> {
         }
     }
 
-    pub fn kernel(&self) -> Quintic<D> {
+    pub fn kernel(&self) -> Kernel<D> {
         self.kernel
     }
 
@@ -312,7 +312,7 @@ impl<const D: usize> Step<D> {
             bodies.set_solve_densities(p, time);
         }
         laps.lap(cell_list::NAME);
-        let (limit, _) = time_step::limiting(p, self.kernel.h(), &self.settings)?;
+        let (limit, _) = time_step::limiting(p, self.kernel.width(), &self.settings)?;
         let (length, lands_on_target) = time_step::length(limit, target - time);
         let set = &self.settings;
         let dt = length.dt;

@@ -3,6 +3,7 @@
 //! counts come from the arrays themselves (`Simulation::arrays`, `Particles::arrays_mut`), so
 //! the plan and the step cannot disagree.
 
+use crate::math::kernel::KernelKind;
 use crate::scene::{BodyMotion, Effects, Scene};
 use crate::scene::{CubeRule, Probe, SurfaceSettings};
 use crate::simulation::{NoFluid, Simulation};
@@ -28,6 +29,9 @@ pub struct Plan {
     pub fluid_particles: usize,
     pub wall_particles: usize,
     pub smoothing_length: f64,
+    pub kernel: KernelKind,
+    /// The kernel support radius, in spacings.
+    pub support_in_dx: f64,
     pub wall_layers: usize,
     pub effects: Effects,
     /// The container's prescribed motion, described (None: at rest).
@@ -114,6 +118,8 @@ impl Plan {
             fluid_particles: fluid,
             wall_particles: total - fluid,
             smoothing_length: scene.smoothing_length(),
+            kernel: scene.solver.kernel,
+            support_in_dx: scene.support_in_dx(),
             wall_layers: scene.wall_layers(),
             effects: scene.effects,
             container_motion: scene.container_motion.as_ref().map(|t| t.describe()),
@@ -191,8 +197,13 @@ impl fmt::Display for Plan {
         writeln!(f, "scene {} ({}D)", self.scene, self.dimensions)?;
         writeln!(
             f,
-            "particles: {} fluid + {} wall and body = {n}   (h = {:.4e} m, {} wall layers)",
-            self.fluid_particles, self.wall_particles, self.smoothing_length, self.wall_layers
+            "particles: {} fluid + {} wall and body = {n}   ({} kernel, h = {:.4e} m, support {:.2} dx, {} wall layers)",
+            self.fluid_particles,
+            self.wall_particles,
+            self.kernel.name(),
+            self.smoothing_length,
+            self.support_in_dx,
+            self.wall_layers
         )?;
         writeln!(f, "effects: {}", effects_line(&self.effects))?;
         if let Some(motion) = &self.container_motion {
@@ -240,7 +251,7 @@ impl fmt::Display for Plan {
             writeln!(f, "at every frame: {}", surface_line(s, self.dimensions))?;
         }
         if !self.probes.is_empty() {
-            writeln!(f, "after every step, into probes.csv (the Shepard sum of the fluid particles within 3h; no array):")?;
+            writeln!(f, "after every step, into probes.csv (the Shepard sum of the fluid particles within the kernel support; no array):")?;
             for p in &self.probes {
                 writeln!(
                     f,

@@ -8,14 +8,15 @@ use crate::math::mesh::TriangleMesh;
 
 use super::file::{
     BodySection, BoxSection, CheckpointSection, EffectsSection, InitialVelocitySection, LesSection,
-    ProbeSection, SceneFile, ShapeSection, ShiftingSection, SimulationSection, SurfaceSection,
+    ProbeSection, SceneFile, ShapeSection, ShiftingSection, SimulationSection, SolverSection,
+    SurfaceSection,
 };
 use super::{
     Aabb, Block, Body, BodyMass, BodyMotion, CheckpointSettings, Effects, InitialVelocity,
     LesSettings, Probe, ProbeField, Scene, SceneError, Shape, ShiftingSettings, SolverSettings,
     SurfaceRequest, SurfaceSettings,
 };
-use crate::math::kernel::SUPPORT_IN_H;
+use crate::math::kernel::KernelKind;
 use std::path::Path;
 
 /// Frames a scene may ask for, at most (end_time / output_interval).
@@ -181,11 +182,12 @@ impl Validator<'_> {
             max: f.container.max.clone(),
         };
         let container = self.aabb(&container_box, dims, "container", s.spacing)?;
+        let solver = self.solver(&f.solver)?;
         let periodic = self.periodic(
             f.container.periodic.as_deref(),
             &container,
             s.spacing,
-            &f.solver,
+            &solver,
         )?;
         self.check(
             !f.fluid_block.is_empty(),
@@ -267,36 +269,6 @@ impl Validator<'_> {
             obstacles.push(region);
         }
 
-        let sv = &f.solver;
-        self.check(
-            sv.tolerance > 0.0 && sv.tolerance < 1.0,
-            "solver.tolerance",
-            format!("= {:?} must lie in (0, 1)", sv.tolerance),
-        )?;
-        self.check(
-            sv.max_iterations >= 1,
-            "solver.max_iterations",
-            "must be at least 1",
-        )?;
-        self.check(
-            (0.0..=1.0).contains(&sv.alpha),
-            "solver.alpha",
-            format!(
-                "= {:?} must lie in [0, 1] (0: divergence-free only, 1: density-invariant only)",
-                sv.alpha
-            ),
-        )?;
-        self.check(
-            sv.cfl > 0.0 && sv.cfl <= 1.0,
-            "solver.cfl",
-            format!("= {:?} must lie in (0, 1]", sv.cfl),
-        )?;
-        self.check(
-            (1.0..=2.0).contains(&sv.h_over_dx),
-            "solver.h_over_dx",
-            format!("= {:?} must lie in [1, 2]", sv.h_over_dx),
-        )?;
-
         let initial_velocity = f
             .initial_velocity
             .as_ref()
@@ -371,7 +343,7 @@ impl Validator<'_> {
             obstacles,
             container_motion,
             initial_velocity,
-            solver: f.solver,
+            solver,
             checkpoint,
             effects,
             walls: f.walls,
@@ -417,6 +389,69 @@ impl Validator<'_> {
         Ok(())
     }
 
+    /// `[solver]`: each key in its range, the ones left out at their defaults (h/dx the
+    /// kernel's).
+    fn solver(&self, sv: &SolverSection) -> Result<SolverSettings, SceneError> {
+        let defaults = SolverSettings::default();
+        let kernel = match &sv.kernel {
+            None => defaults.kernel,
+            Some(name) => KernelKind::from_name(name).ok_or_else(|| {
+                self.error(
+                    "solver.kernel",
+                    format!(
+                        "= \"{name}\" is not a kernel: one of {}",
+                        KernelKind::NAMES.join(", ")
+                    ),
+                )
+            })?,
+        };
+        let solver = SolverSettings {
+            tolerance: sv.tolerance.unwrap_or(defaults.tolerance),
+            max_iterations: sv.max_iterations.unwrap_or(defaults.max_iterations),
+            alpha: sv.alpha.unwrap_or(defaults.alpha),
+            cfl: sv.cfl.unwrap_or(defaults.cfl),
+            kernel,
+            h_over_dx: sv.h_over_dx.unwrap_or(kernel.default_h_over_dx()),
+        };
+        let sv = &solver;
+        self.check(
+            sv.tolerance > 0.0 && sv.tolerance < 1.0,
+            "solver.tolerance",
+            format!("= {:?} must lie in (0, 1)", sv.tolerance),
+        )?;
+        self.check(
+            sv.max_iterations >= 1,
+            "solver.max_iterations",
+            "must be at least 1",
+        )?;
+        self.check(
+            (0.0..=1.0).contains(&sv.alpha),
+            "solver.alpha",
+            format!(
+                "= {:?} must lie in [0, 1] (0: divergence-free only, 1: density-invariant only)",
+                sv.alpha
+            ),
+        )?;
+        self.check(
+            sv.cfl > 0.0 && sv.cfl <= 1.0,
+            "solver.cfl",
+            format!("= {:?} must lie in (0, 1]", sv.cfl),
+        )?;
+        let range = kernel.h_over_dx_range();
+        self.check(
+            range.contains(&sv.h_over_dx),
+            "solver.h_over_dx",
+            format!(
+                "= {:?} must lie in [{:?}, {:?}] with the {} kernel",
+                sv.h_over_dx,
+                range.start(),
+                range.end(),
+                kernel.name()
+            ),
+        )?;
+        Ok(solver)
+    }
+
     /// `container.periodic`: one flag per axis. A periodic axis must hold a whole number of
     /// particle spacings (the lattice must close on itself) and at least three kernel supports
     /// (so that a particle never meets two images of another).
@@ -440,7 +475,7 @@ impl Validator<'_> {
                 flags.len()
             ),
         )?;
-        let support = SUPPORT_IN_H * solver.h_over_dx * spacing;
+        let support = solver.kernel.support_in_h() * solver.h_over_dx * spacing;
         for d in (0..dims).filter(|&d| flags[d]) {
             let length = container.max[d] - container.min[d];
             let spacings = length / spacing;
@@ -452,7 +487,7 @@ impl Validator<'_> {
             self.check(
                 length >= 3.0 * support,
                 key,
-                format!("axis {d} is periodic, so its length {length:?} m must be at least three kernel supports (3 × 3h = {:.4} m)", 3.0 * support),
+                format!("axis {d} is periodic, so its length {length:?} m must be at least three kernel supports (3 × {:.4} m)", support),
             )?;
         }
         Ok(flags.to_vec())
