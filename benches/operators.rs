@@ -8,6 +8,7 @@
 //! (`Simulation::advance_probing`), handed over in one more step.
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
+use isph::math::kernel::KernelKind;
 use isph::math::reduce::fill;
 use isph::neighbours::Neighbours;
 use isph::particles::Particles;
@@ -22,7 +23,7 @@ use std::time::Duration;
 const SETTLE_STEPS: usize = 3;
 
 fn bench<const D: usize>(c: &mut Criterion, spacing: f64) {
-    let scene = dam_break_scene(D, spacing).unwrap();
+    let scene = dam_break_scene(D, spacing, KernelKind::Quintic).unwrap();
     let mut sim = Simulation::<D>::new(&scene).unwrap();
     for _ in 0..SETTLE_STEPS {
         sim.advance_towards(scene.end_time).unwrap();

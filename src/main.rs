@@ -201,6 +201,9 @@ enum Command {
         /// Untimed steps before them (the first step from rest solves the PPE from zero).
         #[arg(long, default_value_t = 1)]
         warmup: usize,
+        /// The kernel (solver.kernel: quintic, wendland_c2, wendland_c4), at its default h/dx.
+        #[arg(long, default_value = "quintic")]
+        kernel: String,
         /// Also write the results to this CSV file.
         #[arg(long)]
         csv: Option<PathBuf>,
@@ -473,6 +476,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             threads,
             steps,
             warmup,
+            kernel,
             csv,
             child,
         } => {
@@ -481,13 +485,14 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             } else {
                 threads
             };
-            let opts = BenchOptions::new(&sizes, &threads, Schedule { warmup, steps }, csv)?;
+            let schedule = Schedule { warmup, steps };
+            let opts = BenchOptions::new(&sizes, &threads, schedule, &kernel, csv)?;
             if child {
                 return bench_child(&opts);
             }
             let exe = std::env::current_exe().context("locating the isph executable")?;
             let rows = bench::run(&opts, &exe, |line| eprintln!("{line}"))?;
-            out!("{}", bench::table(&rows, opts.schedule));
+            out!("{}", bench::table(&rows, opts.schedule, opts.kernel));
             if let Some(csv) = &opts.csv {
                 outln!("written: {}", csv.display());
             }
@@ -502,7 +507,7 @@ fn bench_child(opts: &BenchOptions) -> anyhow::Result<()> {
         bail!("--child measures one point: give one size and one thread count");
     };
     start_threads(Some(threads))?;
-    let m = bench::measure_point(size, opts.schedule)?;
+    let m = bench::measure_point(size, opts.schedule, opts.kernel)?;
     out!("{}", m.to_toml());
     Ok(())
 }

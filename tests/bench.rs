@@ -8,6 +8,7 @@ use std::process::Output;
 const COLUMNS: &[&str] = &[
     "requested_fluid",
     "threads",
+    "kernel",
     "spacing_m",
     "fluid_particles",
     "particles",
@@ -61,6 +62,8 @@ fn bench_writes_one_csv_row_per_point() {
         "2",
         "--warmup",
         "1",
+        "--kernel",
+        "wendland_c2",
         "--csv",
         csv.to_str().unwrap(),
     ]);
@@ -70,12 +73,18 @@ fn bench_writes_one_csv_row_per_point() {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(header, COLUMNS);
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 1, "{text}");
-    let value = |name: &str| rows[0][COLUMNS.iter().position(|c| *c == name).unwrap()];
-    assert!(rows[0].iter().all(|v| v.is_finite()), "{text}");
+    let column = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap();
+    assert_eq!(rows[0][column("kernel")], "wendland_c2");
+    let value = |name: &str| -> f64 { rows[0][column(name)].parse().unwrap() };
+    assert!(
+        COLUMNS
+            .iter()
+            .filter(|&&c| c != "kernel")
+            .all(|c| value(c).is_finite()),
+        "{text}"
+    );
     // 1000 wanted: the spacing 0.1/3 m, a block of 9 × 12 × 15 particles.
     assert_eq!(value("fluid_particles"), 1620.0);
     assert!(value("particles") > value("fluid_particles"));
@@ -94,6 +103,7 @@ fn bench_writes_one_csv_row_per_point() {
     }
     let table = String::from_utf8_lossy(&o.stdout);
     assert!(table.contains("pressure solve"), "{table}");
+    assert!(table.contains("wendland_c2 kernel at h/dx 1.8"), "{table}");
 }
 
 #[test]
@@ -104,6 +114,10 @@ fn bench_refuses_bad_sizes_threads_and_an_unwritable_csv() {
         (&["--sizes", "2500.5"], "--sizes 2500.5"),
         (&["--sizes", "1000", "--threads", "0"], "--threads 0"),
         (&["--sizes", "1000", "--steps", "0"], "--steps"),
+        (
+            &["--sizes", "1000", "--kernel", "cubic"],
+            "--kernel \"cubic\": not a kernel; give one of quintic, wendland_c2, wendland_c4",
+        ),
         (
             &[
                 "--sizes",

@@ -10,6 +10,7 @@
 //! [`Measurement`] as TOML on stdout; the parent collects the points, prints a table and writes
 //! the CSV.
 
+use crate::math::kernel::KernelKind;
 use crate::math::reduce::in_pool;
 use crate::particles::Kind;
 use crate::scene::{Scene, SceneError};
@@ -50,6 +51,8 @@ pub enum BenchError {
     Threads { value: usize },
     #[error("--steps must be at least 1 (the steps timed at each point)")]
     Steps,
+    #[error("--kernel {value:?}: not a kernel; give one of {}", KernelKind::NAMES.join(", "))]
+    Kernel { value: String },
     #[error("cannot write the CSV file {}: {source}", path.display())]
     Csv {
         path: PathBuf,
@@ -86,9 +89,13 @@ pub fn spacing_for(fluid: usize) -> f64 {
     UNIT / m
 }
 
-/// The dam break of `scenes/dam_break_3d.toml` at `spacing`; in 2D its x–z section (tank
-/// 1.0 × 0.6 m, block 0.3 × 0.5 m).
-pub fn dam_break_scene(dimensions: usize, spacing: f64) -> Result<Scene, SceneError> {
+/// The dam break of `scenes/dam_break_3d.toml` at `spacing` with `kernel` at its default h/dx;
+/// in 2D its x–z section (tank 1.0 × 0.6 m, block 0.3 × 0.5 m).
+pub fn dam_break_scene(
+    dimensions: usize,
+    spacing: f64,
+    kernel: KernelKind,
+) -> Result<Scene, SceneError> {
     let axes: &[usize] = if dimensions == 2 { &[0, 2] } else { &[0, 1, 2] };
     let list = |v: [f64; 3]| {
         let parts: Vec<String> = axes.iter().map(|&a| format!("{:?}", v[a])).collect();
@@ -114,7 +121,10 @@ pub fn dam_break_scene(dimensions: usize, spacing: f64) -> Result<Scene, SceneEr
          max = [{block}]\n\
          [container]\n\
          min = [{zero}]\n\
-         max = [{tank}]\n",
+         max = [{tank}]\n\
+         [solver]\n\
+         kernel = \"{kernel}\"\n",
+        kernel = kernel.name(),
         gravity = list(gravity),
         zero = list([0.0; 3]),
         block = list(BLOCK),
@@ -139,6 +149,8 @@ pub struct Measurement {
     pub requested: usize,
     /// Threads of the pool that ran the steps.
     pub threads: usize,
+    /// The kernel's name (`solver.kernel`).
+    pub kernel: String,
     pub spacing: f64,
     pub fluid_particles: usize,
     /// Fluid and wall particles.
@@ -166,12 +178,20 @@ pub struct Measurement {
 }
 
 /// Runs one point in this process (the child's work), on the current rayon pool.
-pub fn measure_point(requested: usize, schedule: Schedule) -> Result<Measurement, BenchError> {
-    in_pool(|| measure_in_pool(requested, schedule))
+pub fn measure_point(
+    requested: usize,
+    schedule: Schedule,
+    kernel: KernelKind,
+) -> Result<Measurement, BenchError> {
+    in_pool(|| measure_in_pool(requested, schedule, kernel))
 }
 
-fn measure_in_pool(requested: usize, schedule: Schedule) -> Result<Measurement, BenchError> {
-    let scene = dam_break_scene(3, spacing_for(requested))?;
+fn measure_in_pool(
+    requested: usize,
+    schedule: Schedule,
+    kernel: KernelKind,
+) -> Result<Measurement, BenchError> {
+    let scene = dam_break_scene(3, spacing_for(requested), kernel)?;
     let mut sim = Simulation::<3>::new(&scene)?;
     for _ in 0..schedule.warmup {
         sim.advance_towards(END_TIME)?;
@@ -199,6 +219,7 @@ fn measure_in_pool(requested: usize, schedule: Schedule) -> Result<Measurement, 
     Ok(Measurement {
         requested,
         threads: rayon::current_num_threads(),
+        kernel: kernel.name().into(),
         spacing: scene.spacing,
         fluid_particles,
         particles,
@@ -266,6 +287,7 @@ pub struct BenchOptions {
     /// Thread counts, ascending.
     pub threads: Vec<usize>,
     pub schedule: Schedule,
+    pub kernel: KernelKind,
     pub csv: Option<PathBuf>,
 }
 
@@ -275,8 +297,12 @@ impl BenchOptions {
         sizes: &[f64],
         threads: &[usize],
         schedule: Schedule,
+        kernel: &str,
         csv: Option<PathBuf>,
     ) -> Result<Self, BenchError> {
+        let kernel = KernelKind::from_name(kernel).ok_or_else(|| BenchError::Kernel {
+            value: kernel.into(),
+        })?;
         let mut sizes = sizes
             .iter()
             .map(|&s| fluid_count(s))
@@ -296,6 +322,7 @@ impl BenchOptions {
             sizes,
             threads,
             schedule,
+            kernel,
             csv,
         })
     }
@@ -362,6 +389,7 @@ impl Row {
         let mut f: Vec<(String, String)> = vec![
             ("requested_fluid".into(), m.requested.to_string()),
             ("threads".into(), m.threads.to_string()),
+            ("kernel".into(), m.kernel.clone()),
             ("spacing_m".into(), m.spacing.to_string()),
             ("fluid_particles".into(), m.fluid_particles.to_string()),
             ("particles".into(), m.particles.to_string()),
@@ -497,7 +525,7 @@ pub fn run(
                 rows.len() + 1,
                 spacing_for(requested)
             ));
-            let m = run_child(exe, requested, threads, opts.schedule)?;
+            let m = run_child(exe, requested, threads, opts.schedule, opts.kernel)?;
             let baseline = rows.iter().find(|r| r.m.requested == requested);
             let parallel_efficiency = match baseline {
                 Some(b) => {
@@ -532,6 +560,7 @@ fn run_child(
     requested: usize,
     threads: usize,
     schedule: Schedule,
+    kernel: KernelKind,
 ) -> Result<Measurement, BenchError> {
     child::run(
         Command::new(exe)
@@ -539,7 +568,8 @@ fn run_child(
             .args(["--sizes", &requested.to_string()])
             .args(["--threads", &threads.to_string()])
             .args(["--steps", &schedule.steps.to_string()])
-            .args(["--warmup", &schedule.warmup.to_string()]),
+            .args(["--warmup", &schedule.warmup.to_string()])
+            .args(["--kernel", kernel.name()]),
     )
     .map_err(|source| BenchError::Point {
         requested,
@@ -549,14 +579,16 @@ fn run_child(
 }
 
 /// The human table of the rows: one line per point, then the time per stage.
-pub fn table(rows: &[Row], schedule: Schedule) -> String {
+pub fn table(rows: &[Row], schedule: Schedule, kernel: KernelKind) -> String {
     let mut t = String::new();
     let (tank, block) = (TANK.map(|x| x.to_string()), BLOCK.map(|x| x.to_string()));
     let _ = writeln!(
         t,
-        "3D dam break, tank {} m, block {} m; {} warm-up + {} timed steps per point; times are medians over the timed steps [min, max]",
+        "3D dam break, tank {} m, block {} m, {} kernel at h/dx {}; {} warm-up + {} timed steps per point; times are medians over the timed steps [min, max]",
         tank.join(" × "),
         block.join(" × "),
+        kernel.name(),
+        kernel.default_h_over_dx(),
         schedule.warmup,
         schedule.steps
     );
