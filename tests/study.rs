@@ -190,3 +190,37 @@ fn bad_study_files_are_refused_with_the_file_and_key_named() {
         assert!(!out.exists(), "{what}: wrote {}", out.display());
     }
 }
+
+/// A grid value the scene refuses alone but accepts beside another key's value is taken: h/dx
+/// 2.5 is out of the quintic's range (the scene's kernel) and inside the Wendland kernels'.
+/// A point of the grid the scene refuses still refuses the study, naming the point.
+#[test]
+fn a_grid_value_valid_beside_another_key_is_taken() {
+    use isph::tools::study::file::Study;
+    let dir = TempDir::new("study-kernel-grid");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hydrostatic_2d.toml");
+    let write = |grid: &str| {
+        let path = dir.path().join("kernels.toml");
+        let text = format!(
+            "scene = \"{}\"\nmeasure = \"hydrostatic\"\n[grid]\n{grid}",
+            scene.display()
+        );
+        std::fs::write(&path, text).unwrap();
+        Study::load(&path)
+    };
+    let study = write("\"solver.kernel\" = [\"wendland_c2\"]\n\"solver.h_over_dx\" = [1.8, 2.5]\n")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(study.points.len(), 2);
+    let e =
+        write("\"solver.kernel\" = [\"quintic\", \"wendland_c2\"]\n\"solver.h_over_dx\" = [2.5]\n")
+            .unwrap_err()
+            .to_string();
+    assert!(e.contains("the point") && e.contains("quintic"), "{e}");
+    let e = write("\"solver.h_over_dx\" = [3.5]\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("grid.\"solver.h_over_dx\"") && e.contains("3.5"),
+        "{e}"
+    );
+}
