@@ -54,16 +54,25 @@ fn triad(c: &mut Criterion) {
 }
 
 fn fma(c: &mut Criterion) {
+    on_every_core(c, "fma", 2 * LANES * CHAINS * FMA_ROUNDS, fma_chains);
+}
+
+fn sqrt_div(c: &mut Criterion) {
+    on_every_core(
+        c,
+        "sqrt_div",
+        LANES * CHAINS * SQRT_DIV_ROUNDS,
+        sqrt_div_chains,
+    );
+}
+
+/// Benches `work` run at once on every thread of the pool, `elements` of it per thread.
+fn on_every_core(c: &mut Criterion, name: &str, elements: usize, work: fn() -> f64) {
     let threads = rayon::current_num_threads();
     let mut g = c.benchmark_group("ceiling");
-    g.throughput(Throughput::Elements(
-        (2 * LANES * CHAINS * FMA_ROUNDS * threads) as u64,
-    ));
-    g.bench_function(format!("fma_{threads}_threads"), |bench| {
-        bench.iter(|| {
-            let sums: Vec<f64> = rayon::broadcast(|_| fma_chains());
-            black_box(sums)
-        })
+    g.throughput(Throughput::Elements((elements * threads) as u64));
+    g.bench_function(format!("{name}_{threads}_threads"), |bench| {
+        bench.iter(|| black_box(rayon::broadcast(|_| work())))
     });
     g.finish();
 }
@@ -82,21 +91,6 @@ fn fma_chains() -> f64 {
         }
     }
     acc.iter().map(|a| a.reduce_add()).sum()
-}
-
-fn sqrt_div(c: &mut Criterion) {
-    let threads = rayon::current_num_threads();
-    let mut g = c.benchmark_group("ceiling");
-    g.throughput(Throughput::Elements(
-        (LANES * CHAINS * SQRT_DIV_ROUNDS * threads) as u64,
-    ));
-    g.bench_function(format!("sqrt_div_{threads}_threads"), |bench| {
-        bench.iter(|| {
-            let sums: Vec<f64> = rayon::broadcast(|_| sqrt_div_chains());
-            black_box(sums)
-        })
-    });
-    g.finish();
 }
 
 /// CHAINS independent chains of SQRT_DIV_ROUNDS rounds of one square root and one division

@@ -91,6 +91,13 @@ pub struct SolverSettings {
     pub h_over_dx: f64,
 }
 
+impl SolverSettings {
+    /// The kernel support radius, in spacings.
+    pub fn support_in_dx(&self) -> f64 {
+        self.kernel.support_in_h() * self.h_over_dx
+    }
+}
+
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {
@@ -220,12 +227,7 @@ impl Scene {
 
     /// Number of dummy wall layers that fill the kernel support.
     pub fn wall_layers(&self) -> usize {
-        (self.support_in_dx() - 1e-9).ceil() as usize
-    }
-
-    /// The kernel support radius, in spacings.
-    pub fn support_in_dx(&self) -> f64 {
-        self.solver.kernel.support_in_h() * self.solver.h_over_dx
+        (self.solver.support_in_dx() - 1e-9).ceil() as usize
     }
 
     /// At least as many particles as `fill::build` makes, fluid and wall, counted without making

@@ -14,9 +14,8 @@
 //!    n_i = −∇C_i/|∇C_i|, ∇C_i = Σ_j V_j ∇W_ij; that normal misleads where walls fill one
 //!    side (at the tip of a surge on the floor it points up while the fluid is missing ahead),
 //!    so the scan also runs both ways along the eigenvector of λ_i, the direction in which the
-//!    support is emptiest. A particle inside a
-//!    gap of the fluid or squeezed against a wall has a neighbour in every umbrella; one on
-//!    the surface has none in at least one.
+//!    support is emptiest. A particle inside a gap of the fluid or squeezed against a wall has
+//!    a neighbour in every umbrella; one on the surface has none in at least one.
 //! 3. A particle whose summation density is below 0.9 ρ0 (at h/dx = 1.2, scaled with the kernel's
 //!    reach: `spray_density`) is free surface whatever λ_i says: spray — loose particles at a
 //!    breaking front or an impact, each with some neighbour in every umbrella but no fluid around

@@ -49,10 +49,10 @@ impl Limit {
 
 /// Largest stable Δt of particles `p` with kernel width `h` (`Kernel::width`, the quintic's
 /// smoothing length): CFL (on the particle spacing), viscous and body-force limits, and the one
-/// that sets it. A CFL step far below the smaller of
-/// the body-force and viscous steps means the flow has blown up: that is reported, not
-/// integrated at ever smaller steps (without gravity the viscous step is the reference; an
-/// inviscid flow without gravity has none, and only a non-finite velocity stops it).
+/// that sets it. A CFL step far below the smaller of the body-force and viscous steps means the
+/// flow has blown up: that is reported, not integrated at ever smaller steps (without gravity
+/// the viscous step is the reference; an inviscid flow without gravity has none, and only a
+/// non-finite velocity stops it).
 pub fn limiting<const D: usize>(
     p: &Particles<D>,
     h: f64,

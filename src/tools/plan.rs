@@ -119,7 +119,7 @@ impl Plan {
             wall_particles: total - fluid,
             smoothing_length: scene.smoothing_length(),
             kernel: scene.solver.kernel,
-            support_in_dx: scene.support_in_dx(),
+            support_in_dx: scene.solver.support_in_dx(),
             wall_layers: scene.wall_layers(),
             effects: scene.effects,
             container_motion: scene.container_motion.as_ref().map(|t| t.describe()),

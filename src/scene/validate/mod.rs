@@ -475,7 +475,7 @@ impl Validator<'_> {
                 flags.len()
             ),
         )?;
-        let support = solver.kernel.support_in_h() * solver.h_over_dx * spacing;
+        let support = solver.support_in_dx() * spacing;
         for d in (0..dims).filter(|&d| flags[d]) {
             let length = container.max[d] - container.min[d];
             let spacings = length / spacing;
