@@ -345,7 +345,12 @@ impl Bodies {
     /// its surface: the water's hydrostatic pressure runs through it as through the water,
     /// whatever the body's density, and the fluid's force on it, −Σ V_i ∇P_i, is the same
     /// (docs/bodies.md, "The coupling").
+    /// A scene whose bodies all move freely throughout has nothing to set: the fill gave their
+    /// particles their own mass and density.
     pub fn set_solve_densities<const D: usize>(&self, p: &mut Particles<D>, time: f64) {
+        if self.bodies.iter().all(|b| b.motion == BodyMotion::Free) {
+            return;
+        }
         for i in (0..p.len()).filter(|&i| p.kind[i] == Kind::Body) {
             let body = &self.bodies[p.fluid[i] as usize];
             (p.mass[i], p.rest_density[i]) = match body.motion_at(time) {
