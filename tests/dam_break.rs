@@ -7,9 +7,9 @@ use isph::tools::validation::lobovsky::SENSORS;
 use isph::tools::validation::{measure, Case};
 
 /// Martin & Moyce's 2:1 column at a/30 in a tank long enough for all fifteen of their fronts
-/// (`scenes/dam_break_mm_2d.toml`). Measured: 7.5% mean relative error, the front ahead of the
-/// experiment at every point, by a lead of 0.266 in T that takes the rms misfit from 0.414 to
-/// 0.108, at a speed of 1.36 over T = 1.6–3.3 against the experiment's 1.278 (point by point
+/// (`scenes/dam_break_mm_2d.toml`). Measured: 7.6% mean relative error, the front ahead of the
+/// experiment at every point, by a lead of 0.268 in T that takes the rms misfit from 0.416 to
+/// 0.093, at a speed of 1.38 over T = 1.6–3.3 against the experiment's 1.278 (point by point
 /// and at other spacings: docs/accuracy.md, "Dam break (2D): the surge front against Martin &
 /// Moyce").
 #[test]
@@ -69,10 +69,9 @@ fn dam_break_3d_runs_half_a_second() {
 /// t = 0.55 s (t √(g/H) = 3.1, past every sensor's onset): the time the water reaches each
 /// sensor within 3% of the experiment's. A sensor whose centre lies below the first layer of
 /// fluid particles (half a spacing, 3.75 mm: sensor 1, at 3 mm) is not resolved and not asked
-/// for. Measured at H/40: −0.8%, −3.0%, −2.5% at sensors 2–4, sensor 3 at the edge of the
-/// bound: at this spacing the first water reaches sensors 1–3 within 0.005 in T, so their
-/// onsets differ by the experiment's only (docs/accuracy.md, "Wall pressures against Lobovsky et al.
-/// 2014").
+/// for. Measured at H/40: −0.1%, −2.4%, +1.2% at sensors 2–4: at this spacing the first water
+/// reaches sensors 1–3 in the same step, so their onsets differ by the experiment's only
+/// (docs/accuracy.md, "Wall pressures against Lobovsky et al. 2014").
 #[test]
 fn wall_pressure_onsets_follow_lobovsky() {
     let scene = shipped_scene("dam_break_lobovsky_2d.toml");

@@ -155,10 +155,10 @@ fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize) {
 /// The issue's violent impact at a/40. After the plunge the flow is chaotic, so the worst step
 /// is one draw of a trajectory: a step cut short to land on a frame, or any change to the
 /// arithmetic, draws another. Measured over perturbed trajectories (frames every 0.05 s, the
-/// test, and 0.04, 0.03, 0.025 s): at a/40 the worst step is 0.66–0.93% over four, the mean
-/// over the steps 0.31–0.36%. At a/25, a/30 and a/50 the bound is broken on some trajectories
-/// (docs/stabilisation.md, "The violent impact: a/40 meets the bound on every trajectory
-/// measured").
+/// test, and 0.04, 0.03, 0.025 s) at the defaults (CFL 0.4, α = 0.3): the worst step is
+/// 0.70–0.80% over four, the mean over the steps 0.37–0.39%; at α = 0.1 the bound was broken on
+/// three of four (0.89–1.37%) (docs/stabilisation.md, "The violent impact over its
+/// trajectories").
 #[test]
 fn violent_impact_keeps_density_and_volume() {
     let (dir, frames) = violent_impact(40.0, "", "impact");
@@ -181,8 +181,10 @@ fn violent_impact_keeps_density_and_volume() {
 }
 
 /// The violent impact at a/20 with and without shifting: shifting keeps the particles ordered
-/// through the plunge. Measured: disorder 0.118 at most over the second half with shifting, and
-/// 5.5 times as much on average without (0.394 against 0.072).
+/// through the plunge. The mean disorder over the second half is the measure: 0.074–0.083 over
+/// twelve trajectories (frames every 0.05, 0.04, 0.03 and 0.025 s; α = 0.1, 0.2 and 0.3), and
+/// about 5 times as much without shifting (0.394 against 0.072 on one). Its worst step is one
+/// draw of the chaotic flow, 0.146–0.215 over the same twelve: bounded only against a blow-up.
 #[test]
 fn shifting_keeps_the_violent_impact_ordered() {
     let (shifted, _) = violent_impact(20.0, "", "impact_shifted");
@@ -201,7 +203,11 @@ fn shifting_keeps_the_violent_impact_ordered() {
     let unshifted_end = second_half_mean(&stats_column(plain.path(), "disorder"));
     let shifted_end = second_half_mean(&disorder);
     assert!(
-        shifted_max < 0.2,
+        shifted_end < 0.1,
+        "disorder with shifting {shifted_end} on average over the second half"
+    );
+    assert!(
+        shifted_max < 0.25,
         "disorder with shifting reached {shifted_max}"
     );
     assert!(

@@ -103,7 +103,7 @@ impl Default for SolverSettings {
         Self {
             tolerance: 1.0e-6,
             max_iterations: 1000,
-            alpha: 0.1,
+            alpha: 0.3,
             cfl: 0.4,
             kernel: KernelKind::Quintic,
             h_over_dx: KernelKind::Quintic.default_h_over_dx(),

@@ -23,8 +23,8 @@ use rayon::prelude::*;
 pub const NAME: &str = "pressure solve";
 
 /// The relative residual at which the density correction's solve stops (or the scene's
-/// tolerance, if looser). P_α relaxes a tenth (α) of a density error of a few tenths of a per
-/// cent each step: 1% of it is far below what the next step sees, and from a zero start the
+/// tolerance, if looser). P_α relaxes the fraction α of a density error of a few tenths of a
+/// per cent each step: 1% of it is far below what the next step sees, and from a zero start the
 /// solve at the projection's 1e-6 costs as many iterations as the projection itself
 /// (docs/stabilisation.md, "The density correction moves positions, not velocities").
 const DENSITY_TOLERANCE: f64 = 1e-2;
