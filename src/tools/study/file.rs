@@ -95,11 +95,11 @@ impl Study {
                     // A value the scene refuses alone may hold beside another key's value (an
                     // h/dx in a Wendland kernel's range but not the quintic's): it is refused
                     // only if no point of the grid that holds it loads.
-                    let holds = grid.iter().filter(|p| p.contains(&setting));
-                    if !holds
-                        .into_iter()
-                        .any(|p| scene_with(&scene_text, &scene_path, p).is_ok())
-                    {
+                    let loads_somewhere = grid
+                        .iter()
+                        .filter(|p| p.contains(&setting))
+                        .any(|p| scene_with(&scene_text, &scene_path, p).is_ok());
+                    if !loads_somewhere {
                         let key = format!("grid.\"{key}\"");
                         return Err(invalid(&key, format!("= {value}: {m}")));
                     }
