@@ -271,16 +271,19 @@ friction = 0.5
             rows[k].0
         );
     }
-    // Still: its contact points with the floor are solved together, so the pressure's noise
-    // does not rock it (measured 0.0018 m/s on average over the frames every 0.01 s; 0.015 with
-    // one impulse at the middle of the points that touch).
+    // Still: it rests, held by its contacts (`bodies::contact`, 3.), though the water its fall
+    // set sloshing still moves at 0.25 m/s. Measured on four trajectories (frames every 0.01,
+    // 0.02, 0.025 and 0.05 s): exactly at rest over 1.5–2 s on all four; before it rested,
+    // 0.0016–0.0072 m/s on average, and 0.015 with one contact impulse at the middle of the
+    // points that touch. The bound leaves room for the slosh to rock it on its lattice polygon
+    // past what its weight and friction hold, on another trajectory.
     let speed = late
         .iter()
         .map(|&k| rows[k].1[VX].hypot(rows[k].1[VY]))
         .sum::<f64>()
         / late.len() as f64;
     assert!(
-        speed < 0.01,
+        speed < 0.001,
         "it moves at {speed} m/s on average over 1.5–2 s"
     );
     let drift = rows[*late.last().unwrap()].1[0] - rows[late[0]].1[0];
@@ -520,30 +523,59 @@ fn a_body_held_in_still_water_leaves_it_still_whatever_its_density() {
     }
 }
 
-#[test]
-fn a_heavy_box_resting_on_the_floor_leaves_the_water_nearly_still() {
-    // A box 0.08 m square at s = 1.5 lying on the floor of still water 0.3 m deep: the water's
-    // hydrostatic pressure runs through it (step::hydrostatic_split), and what still moves the
-    // water is the body's excess weight held by its contact after the solve (docs/bodies.md,
-    // "Known limitation"). Measured: the water's kinetic energy over 1–2 s is 0.0065 J/m on
-    // average (an rms speed of 0.009 m/s); with the pairs across the body's surface weighted as
-    // between two fluids, 0.077 J/m, growing.
-    let dir = TempDir::new("bodies-resting-box");
-    let body = "[[body]]\nshape = \"box\"\nmin = [0.26, 0.0]\nmax = [0.34, 0.08]\ndensity = 1500.0\nfriction = 0.5\n";
+/// A heavy body lying on the floor of still water 0.3 m deep from the start (`body` its
+/// section): the water's kinetic energy [J/m] at every frame from 1 s to 2 s, and the body's
+/// largest speed [m/s] over the whole run.
+fn resting_on_the_floor(name: &str, body: &str) -> (Vec<f64>, f64) {
+    let dir = TempDir::new(name);
     let scene = scene_from_text(&tank(2, 0.01, [0.6, 0.4, 0.0], 0.3, 0.01, body));
     run_scene(&scene, dir.path(), 2.0);
     let time = stats_column(dir.path(), "time");
     let energy = stats_column(dir.path(), "kinetic_energy");
-    let late: Vec<f64> = (0..time.len())
+    let late = (0..time.len())
         .filter(|&k| time[k] >= 1.0)
         .map(|k| energy[k])
         .collect();
-    let mean = late.iter().sum::<f64>() / late.len() as f64;
-    eprintln!("the water's kinetic energy over 1–2 s: {mean} J/m on average");
-    assert!(
-        mean < 0.02,
-        "the water beside a resting box holds {mean} J/m"
-    );
+    let fastest = rows(dir.path(), 0)
+        .iter()
+        .map(|r| r.1[VX].hypot(r.1[VY]) + r.1[12].abs() * 0.06)
+        .fold(0.0, f64::max);
+    (late, fastest)
+}
+
+#[test]
+fn a_heavy_body_resting_on_the_floor_stays_at_rest_and_leaves_the_water_still() {
+    // A box 0.08 m square and a circle of D = 0.08 m at s = 1.5 lying on the floor: once their
+    // contacts stop them they rest, held still in the pressure solve while their supports hold
+    // them (`bodies::contact`, 3.), so the water beside them is as still as beside a body of
+    // the water's density. Measured: exactly at rest throughout; the water's kinetic energy
+    // over 1–2 s 1.6e-7 J/m beside the box and 1.1e-7 beside the circle. Before bodies rested,
+    // the solve moved them by their excess weight every step and their contacts stopped them
+    // after: 0.0051 and 0.0067 J/m, the water moving at up to 0.18 and 0.29 m/s, the bodies at
+    // 0.0005 and 0.001 m/s on average.
+    for (name, shape) in [
+        (
+            "box",
+            "shape = \"box\"\nmin = [0.26, 0.0]\nmax = [0.34, 0.08]",
+        ),
+        (
+            "circle",
+            "shape = \"circle\"\ncenter = [0.3, 0.04]\nradius = 0.04",
+        ),
+    ] {
+        let body = format!("[[body]]\n{shape}\ndensity = 1500.0\nfriction = 0.5\n");
+        let (energy, fastest) = resting_on_the_floor(&format!("bodies-resting-{name}"), &body);
+        let most = energy.iter().fold(0.0, |m: f64, e| m.max(*e));
+        eprintln!("{name}: the water's kinetic energy over 1–2 s at most {most} J/m; the body at {fastest} m/s at most");
+        assert!(
+            most < 1e-5,
+            "the water beside a resting {name} holds {most} J/m"
+        );
+        assert!(
+            fastest < 1e-12,
+            "a {name} resting on the floor moved at {fastest} m/s"
+        );
+    }
 }
 
 #[test]
@@ -737,16 +769,29 @@ fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_nothing_passes_thr
         }
     }
     // Once the surge has passed (2–3 s): in still water 0.1 m deep the light discs would float
-    // with their centres near 0.085 m and the heavy ones rest at 0.025 m; the water still
-    // sloshes, so half the difference at least.
-    let height = |b: usize| mean_after(&discs[b], Y, 2.0);
-    let heavy = (0..4).map(height).sum::<f64>() / 4.0;
-    let light = (4..8).map(height).sum::<f64>() / 4.0;
-    eprintln!("mean heights over 2–3 s: heavy {heavy} m, light {light} m");
-    assert!(heavy < 0.035, "the heavy discs are not down: {heavy} m");
+    // with their centres near 0.075 m and the heavy ones rest at 0.025 m. The surge piles them
+    // up as it likes (a heavy disc on two others, a light one wedged under a heavy one, one
+    // pressed into the corner of the floor and the end wall, where no water gets under it), so
+    // most, not all: three of the heavy discs on the floor, two of the light ones afloat.
+    // Measured: heavy 0.025, 0.024, 0.020, 0.022 m, light 0.086, 0.093, 0.089, 0.035 m (before
+    // bodies rested: heavy 0.067, 0.021, 0.024, 0.025, light 0.092, 0.091, 0.077, 0.028).
+    let heights: Vec<f64> = (0..8).map(|b| mean_after(&discs[b], Y, 2.0)).collect();
+    eprintln!(
+        "mean heights over 2–3 s: heavy {:?} m, light {:?} m",
+        &heights[..4],
+        &heights[4..]
+    );
+    let down = heights[..4].iter().filter(|&&y| y < 0.03).count();
+    let afloat = heights[4..].iter().filter(|&&y| y > 0.06).count();
     assert!(
-        light > heavy + 0.03,
-        "heavy discs at {heavy} m, light ones at {light} m"
+        down >= 3,
+        "{down} heavy discs on the floor: {:?}",
+        &heights[..4]
+    );
+    assert!(
+        afloat >= 2,
+        "{afloat} light discs afloat: {:?}",
+        &heights[4..]
     );
 }
 

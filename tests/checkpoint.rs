@@ -287,7 +287,8 @@ fn a_continued_3d_run_is_bit_identical_to_one_never_stopped() {
 #[test]
 fn a_continued_run_with_bodies_in_a_rolling_tank_is_bit_identical_to_one_never_stopped() {
     let dir = TempDir::new("ckpt-bodies");
-    // The tank rolls, and a paddle moves on a sinusoid beside the floating box.
+    // The tank rolls, a paddle moves on a sinusoid beside the floating box, and a heavy box
+    // rests on the floor.
     let edits = [
         ("spacing = 0.005 ", "spacing = 0.02 "),
         (
@@ -296,13 +297,26 @@ fn a_continued_run_with_bodies_in_a_rolling_tank_is_bit_identical_to_one_never_s
         ),
         (
             "density = 500.0                 # [kg/m^3]: s = 0.5",
-            "density = 500.0\n\n[[body]]\nname = \"paddle\"\nshape = \"box\"\nmin = [0.06, 0.2]\nmax = [0.1, 0.4]\ndensity = 1000.0\nmotion = \"prescribed\"\n\n[body.trajectory]\nperiod = 0.5\namplitude = [0.02, 0.0]\nangle = 5.0\n",
+            "density = 500.0\n\n[[body]]\nname = \"paddle\"\nshape = \"box\"\nmin = [0.06, 0.2]\nmax = [0.1, 0.4]\ndensity = 1000.0\nmotion = \"prescribed\"\n\n[body.trajectory]\nperiod = 0.5\namplitude = [0.02, 0.0]\nangle = 5.0\n\n[[body]]\nname = \"rester\"\nshape = \"box\"\nmin = [0.8, 0.0]\nmax = [0.88, 0.08]\ndensity = 1500.0\nfriction = 0.5\n",
         ),
     ];
     let file = scene_file(dir.path(), "floating_box_2d.toml", &edits, 0.1, 2);
     let scene = Scene::load(&file).unwrap();
-    // Stopped while the box heaves: its state comes from the checkpoint, not the scene.
+    // Stopped while the box heaves and the heavy one rests: their states come from the
+    // checkpoint, not the scene.
     assert_split_run_is_identical::<2>(dir.path(), &scene, 0.2, 0.4);
+    let rows = std::fs::read_to_string(dir.path().join("split/bodies.csv")).unwrap();
+    let at_stop = rows
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .find(|c| c[1] == "2" && (c[0].parse::<f64>().unwrap() - 0.2).abs() < 1e-9)
+        .unwrap_or_else(|| panic!("no row of the resting box at 0.2 s in {rows}"));
+    let velocity: Vec<f64> = at_stop[10..13].iter().map(|v| v.parse().unwrap()).collect();
+    assert_eq!(
+        velocity, [0.0; 3],
+        "the heavy box does not rest at the stop: {at_stop:?}"
+    );
 }
 
 #[test]

@@ -65,8 +65,8 @@ fn one_and_two_threads_write_bit_identical_frames() {
     assert_thread_count_independent("dam-break", &scene, 0.03, 3);
 }
 
-/// Bodies, free and prescribed, in a rolling tank: their sums run in the sorted order on one
-/// thread.
+/// Bodies, free, prescribed and resting, in a rolling tank: their sums run in the sorted order
+/// on one thread.
 #[test]
 fn free_and_prescribed_bodies_in_a_rolling_tank_are_bit_identical_on_one_and_two_threads() {
     let mut scene = shipped_scene("floating_box_2d.toml");
@@ -100,7 +100,18 @@ fn free_and_prescribed_bodies_in_a_rolling_tank_are_bit_identical_on_one_and_two
     };
     paddle.motion =
         isph::scene::BodyMotion::Prescribed(roll([0.02, 0.0, 0.0], 5.0, 0.5, [0.85, 0.3, 0.0]));
-    scene.bodies.push(paddle);
+    scene.bodies.push(paddle.clone());
+    // A heavy box resting on the floor, held still while its contacts hold it.
+    let mut rester = paddle;
+    rester.name = "rester".into();
+    rester.shape = isph::scene::Shape::Box {
+        min: vec![0.6, 0.0],
+        max: vec![0.68, 0.08],
+    };
+    rester.motion = isph::scene::BodyMotion::Free;
+    rester.mass = isph::scene::BodyMass::Density(1500.0);
+    rester.friction = 0.5;
+    scene.bodies.push(rester);
     scene.container_motion = Some(roll([0.0; 3], 3.0, 1.0, [0.5, 0.0, 0.0]));
     assert_thread_count_independent("bodies", &scene, 0.2, 4);
 }

@@ -28,7 +28,20 @@
 //!    normal velocity apart to −e v_n⁰ if it approached at v_n⁰ < 0 before the solve and to 0
 //!    otherwise, and its friction impulse stops its sliding up to the Coulomb bound
 //!    |λ_t| ≤ μ λ. Resting on a face, the solution stops the body's approach and its turn
-//!    together.
+//!    together. A point approaching slower than |g| Δt does not bounce: a body lying on a
+//!    surface approaches it at up to that speed in every step, and would never come to rest.
+//! 3. **Resting.** A free body whose contact points' solve stops it (all but `HELD` of its
+//!    largest speed), one of them a support its weight in the water presses it onto (a heavy
+//!    body's floor, a light one's lid), rests: its velocity is set to zero, and over the next step it is held
+//!    where it is, as a fixed body is, so the pressure solve sees a body that does not move
+//!    (`RigidBody::target`). After that solve its velocity from rest is what the fluid's force
+//!    on the held body and its own body forces give it over the step (`Bodies::advance`), and
+//!    the same contact solve either stops it again (it stays at rest) or not: then its
+//!    supports cannot hold it (it is lifted, slides past its friction, or tips) and it moves
+//!    off with what the contacts leave it. This is static friction and the floor's reaction
+//!    acting within the step; without it the solve moved a body lying on the floor by its
+//!    excess weight in every step and its contact stopped it after, stirring the water beside
+//!    it and jittering (docs/bodies.md, "Contact").
 //!
 //! e is the larger of the two restitutions, μ the geometric mean of the two frictions (as
 //! Box2D combines them); a face or an obstacle takes the body's own. Everything runs over the
@@ -47,6 +60,11 @@ const PASSES: usize = 4;
 /// point: the points of a body's side lying on a face differ in depth by its tilt (0.05
 /// spacing is a tilt of 3° across a side a spacing wide), and all of them hold it.
 const SLOP: f64 = 0.05;
+
+/// A body whose contact points' solve takes all but this fraction of its largest speed is held
+/// by them, and rests (module doc, 3.): the solve stops to `TOLERANCE` of its impulses, and a
+/// body that slides, turns or lifts off keeps far more than this.
+const HELD: f64 = 1e-6;
 
 /// Most sweeps of the contact points' solve; it stops earlier when a sweep changes no impulse
 /// by more than `TOLERANCE` of the largest.
@@ -133,20 +151,37 @@ impl Motion {
 }
 
 impl Bodies {
-    /// Resolves the contacts of the bodies after their move over the step from `time`.
-    pub fn resolve_contacts(&mut self, time: f64) {
+    /// Resolves the contacts of the bodies after their move over the step of `dt` from `time`,
+    /// and finds which rest on the faces and the obstacles (module doc, 3.).
+    pub fn resolve_contacts(&mut self, time: f64, dt: f64) {
         let free: Vec<bool> = self.bodies.iter().map(|b| moves_freely(b, time)).collect();
         self.separate(&free);
+        let bounce_above = dot(self.gravity, self.gravity).sqrt() * dt;
         for a in (0..self.bodies.len()).filter(|&a| free[a]) {
             let mut points = self.contact_points(&self.bodies[a]);
-            if points.is_empty() {
-                continue;
-            }
             let body = &mut self.bodies[a];
-            let mut motion = Motion::of(body, true);
-            solve_contact_points(&mut points, &mut motion, body.restitution, body.friction);
-            body.state.velocity = motion.velocity;
-            body.state.angular_momentum = motion.angular_momentum;
+            let before = body.largest_speed();
+            if !points.is_empty() {
+                let mut motion = Motion::of(body, true);
+                let bounce = Bounce {
+                    restitution: body.restitution,
+                    above: bounce_above,
+                };
+                solve_contact_points(&mut points, &mut motion, bounce, body.friction);
+                body.state.velocity = motion.velocity;
+                body.state.angular_momentum = motion.angular_momentum;
+            }
+            let weight = body.weight_in_water(self.gravity, self.water_density);
+            let supported = points.iter().any(|c| dot(weight, c.normal) < 0.0);
+            let held = supported && body.largest_speed() <= HELD * before;
+            if held {
+                body.state.velocity = [0.0; 3];
+                body.state.angular_momentum = [0.0; 3];
+            } else if body.state.resting {
+                // Let go: it moves over this step from rest.
+                body.drift([0.0; 3], dt);
+            }
+            body.state.resting = held;
         }
     }
 
@@ -280,17 +315,29 @@ impl ContactPoint {
     }
 }
 
+/// How a contact point bounces: by the body's `restitution`, where it approaches faster than
+/// `above`.
+#[derive(Clone, Copy, Debug)]
+struct Bounce {
+    restitution: f64,
+    above: f64,
+}
+
 /// The impulses of all of a body's contact points with the faces and the obstacles together,
-/// by projected Gauss–Seidel (module doc, 2.), with the body's `restitution` and `friction`.
+/// by projected Gauss–Seidel (module doc, 2.), with its `bounce` and `friction`.
 fn solve_contact_points(
     points: &mut [ContactPoint],
     motion: &mut Motion,
-    restitution: f64,
+    bounce: Bounce,
     friction: f64,
 ) {
     for c in points.iter_mut() {
         let approach = dot(motion.velocity_at(c.arm), c.normal);
-        c.target = -restitution * approach.min(0.0);
+        c.target = if approach < -bounce.above {
+            -bounce.restitution * approach
+        } else {
+            0.0
+        };
     }
     for _ in 0..SWEEPS {
         let (mut change, mut largest) = (0.0f64, 0.0f64);

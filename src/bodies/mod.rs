@@ -46,11 +46,14 @@ pub struct RigidState {
     /// the contacts' impulses).
     pub force: Vec3,
     pub torque: Vec3,
+    /// Whether a free body rests on the container's faces or the obstacles: held still over
+    /// the next step, as long as its contacts can hold it (`Bodies::resolve_contacts`).
+    pub resting: bool,
 }
 
 impl RigidState {
-    /// f64s of a state in a checkpoint.
-    pub const LEN: usize = 19;
+    /// f64s of a state in a checkpoint: `resting` is the last, 1 or 0.
+    pub const LEN: usize = 20;
 
     pub fn to_array(&self) -> [f64; Self::LEN] {
         let mut a = [0.0; Self::LEN];
@@ -67,9 +70,12 @@ impl RigidState {
             a[k..k + part.len()].copy_from_slice(part);
             k += part.len();
         }
+        a[k] = f64::from(u8::from(self.resting));
         a
     }
 
+    /// The state of `a`, one of `to_array` or one of the 19 f64s that checkpoints held before
+    /// `resting` (not resting).
     pub fn from_array(a: &[f64]) -> Self {
         let v = |k: usize| [a[k], a[k + 1], a[k + 2]];
         Self {
@@ -79,6 +85,7 @@ impl RigidState {
             angular_momentum: v(10),
             force: v(13),
             torque: v(16),
+            resting: a.get(19) == Some(&1.0),
         }
     }
 }
@@ -135,12 +142,19 @@ impl RigidBody {
         }
     }
 
-    /// The pose and velocities a fixed or prescribed body has at t + dt when it moves as such
-    /// over the step from t (None for a free body).
+    /// Whether the body is held over the step from t: fixed, prescribed, or resting on its
+    /// supports (`RigidState::resting`).
+    pub fn is_held(&self, t: f64) -> bool {
+        self.target(t, 0.0).is_some()
+    }
+
+    /// The pose and velocities a held body (`is_held`) has at t + dt (None for a body that
+    /// moves freely over the step): where its motion takes it, or for a resting body where it
+    /// is, at rest.
     pub fn target(&self, t: f64, dt: f64) -> Option<RigidTarget> {
         match self.motion_at(t) {
-            BodyMotion::Free => None,
-            BodyMotion::Fixed => Some(RigidTarget {
+            BodyMotion::Free if !self.state.resting => None,
+            BodyMotion::Free | BodyMotion::Fixed => Some(RigidTarget {
                 centre: self.state.centre,
                 orientation: self.state.orientation,
                 velocity: [0.0; 3],
@@ -198,6 +212,33 @@ impl RigidBody {
         rotation::apply(r, self.offsets[(id - self.first_id) as usize])
     }
 
+    /// Moves the pose over a step of `dt` over which the centre's velocity went from `start` to
+    /// the state's: the centre by the trapezoid, exact under a constant force (free fall), and
+    /// the orientation by a turn of ωⁿ⁺¹ Δt (Eq. 15–16).
+    fn drift(&mut self, start: Vec3, dt: f64) {
+        let s = &mut self.state;
+        for d in 0..3 {
+            s.centre[d] += 0.5 * dt * (start[d] + s.velocity[d]);
+        }
+        let w = self.angular_velocity();
+        self.state.orientation = Quaternion::from_rotation_vector(w.map(|w| w * dt))
+            .then_after(self.state.orientation)
+            .normalised();
+    }
+
+    /// Its weight less the weight of the water (of density `water_density`) it displaces, in
+    /// `gravity` [N].
+    fn weight_in_water(&self, gravity: Vec3, water_density: f64) -> Vec3 {
+        let buoyant = 1.0 - water_density / self.particle_density;
+        gravity.map(|g| g * self.mass * buoyant)
+    }
+
+    /// The largest speed of a point of the body, |V| + |ω| times its reach [m/s].
+    fn largest_speed(&self) -> f64 {
+        let (v, w) = (self.state.velocity, self.angular_velocity());
+        dot(v, v).sqrt() + dot(w, w).sqrt() * self.reach
+    }
+
     /// Kinetic energy ½ M V² + ½ ω·L [J].
     pub fn kinetic_energy(&self) -> f64 {
         let (v, w, l) = (
@@ -224,6 +265,13 @@ pub struct Bodies {
     /// The first fluid's rest density, which a held body's particles take in the pressure
     /// solve (`set_solve_densities`).
     water_density: f64,
+    /// Which bodies the particles' masses and rest densities are set as held for (None: not
+    /// known, as at the start of a run or a resumed one).
+    held_in_solve: Option<Vec<bool>>,
+    /// The scene's gravity [m/s²]: a body resting on a surface approaches it at up to |g| Δt
+    /// in a step, which its contact does not take for a collision, and rests only on a support
+    /// its weight in the water presses it onto (`resolve_contacts`).
+    gravity: Vec3,
 }
 
 impl Bodies {
@@ -303,6 +351,7 @@ impl Bodies {
                         angular_momentum: rotation::apply(&inertia, spin),
                         force: [0.0; 3],
                         torque: [0.0; 3],
+                        resting: false,
                     },
                 };
                 // A prescribed body starts moving as its trajectory does at t = 0.
@@ -331,6 +380,8 @@ impl Bodies {
             spacing: scene.spacing,
             dims: D,
             water_density: scene.fluids[0].density,
+            held_in_solve: None,
+            gravity: std::array::from_fn(|d| scene.gravity.get(d).copied().unwrap_or(0.0)),
         }
     }
 
@@ -340,27 +391,29 @@ impl Bodies {
 
     /// Gives each body particle the mass and rest density the step from `time` takes it at:
     /// its body's own where the body moves freely, the water's (the first fluid's) with the
-    /// same volume where it is held (fixed or prescribed). A held body's motion does not
-    /// depend on its mass, and at the water's density the pressure solve sees no interface at
-    /// its surface: the water's hydrostatic pressure runs through it as through the water,
+    /// same volume where it is held (fixed, prescribed or resting). A held body's motion does
+    /// not depend on its mass, and at the water's density the pressure solve sees no interface
+    /// at its surface: the water's hydrostatic pressure runs through it as through the water,
     /// whatever the body's density, and the fluid's force on it, −Σ V_i ∇P_i, is the same
     /// (docs/bodies.md, "The coupling").
-    /// A scene whose bodies all move freely throughout has nothing to set: the fill gave their
-    /// particles their own mass and density.
-    pub fn set_solve_densities<const D: usize>(&self, p: &mut Particles<D>, time: f64) {
-        if self.bodies.iter().all(|b| b.motion == BodyMotion::Free) {
+    /// The particles are visited only when that changes: in a scene whose bodies move freely
+    /// throughout, once.
+    pub fn set_solve_densities<const D: usize>(&mut self, p: &mut Particles<D>, time: f64) {
+        let held: Vec<bool> = self.bodies.iter().map(|b| b.is_held(time)).collect();
+        if self.held_in_solve.as_ref() == Some(&held) {
             return;
         }
         for i in (0..p.len()).filter(|&i| p.kind[i] == Kind::Body) {
-            let body = &self.bodies[p.fluid[i] as usize];
-            (p.mass[i], p.rest_density[i]) = match body.motion_at(time) {
-                BodyMotion::Free => (body.particle_mass, body.particle_density),
-                BodyMotion::Fixed | BodyMotion::Prescribed(_) => {
-                    let volume = body.particle_mass / body.particle_density;
-                    (self.water_density * volume, self.water_density)
-                }
+            let b = p.fluid[i] as usize;
+            let body = &self.bodies[b];
+            (p.mass[i], p.rest_density[i]) = if held[b] {
+                let volume = body.particle_mass / body.particle_density;
+                (self.water_density * volume, self.water_density)
+            } else {
+                (body.particle_mass, body.particle_density)
             };
         }
+        self.held_in_solve = Some(held);
     }
 
     /// Gives the bodies' particles their bodies' rigid velocities (at t = 0).
@@ -383,14 +436,20 @@ impl Bodies {
             .collect()
     }
 
-    /// Restores the states written by `states`; false if `states` does not hold one per body.
+    /// Restores the states written by `states` (or by a checkpoint of 19 f64s a state, before
+    /// `resting`); false if `states` does not hold one per body.
     pub fn restore(&mut self, states: &[f64]) -> bool {
-        if states.len() != self.bodies.len() * RigidState::LEN {
+        let count = self.bodies.len();
+        let Some(len) = [RigidState::LEN, RigidState::LEN - 1]
+            .into_iter()
+            .find(|len| states.len() == count * len)
+        else {
             return false;
-        }
-        for (body, s) in self.bodies.iter_mut().zip(states.chunks(RigidState::LEN)) {
+        };
+        for (body, s) in self.bodies.iter_mut().zip(states.chunks(len)) {
             body.state = RigidState::from_array(s);
         }
+        self.held_in_solve = None;
         true
     }
 
@@ -398,20 +457,25 @@ impl Bodies {
     /// `impulse` and angular momentum `angular_impulse` the step's fluid stages gave its particles
     /// beyond their rigid motion, `applied` the body forces' share of them per unit time (the
     /// sums of m_i f_i and of r_ic × m_i f_i, `ghosts::BodyForce`); a fixed or prescribed one is
-    /// put where its motion says. The contacts are resolved after every body has moved
-    /// (`resolve_contacts`).
+    /// put where its motion says. A resting body stays where it is, and takes as its velocity
+    /// what the fluid's force and `load` (the body forces on its own masses: its weight and
+    /// external force, in a moving container the frame's) would give it over the step from
+    /// rest; its contacts then hold it or let it go (`resolve_contacts`, after every body has
+    /// moved).
+    #[allow(clippy::too_many_arguments)]
     pub fn advance(
         &mut self,
         b: usize,
         impulse: Vec3,
         angular_impulse: Vec3,
         applied: [Vec3; 2],
+        load: [Vec3; 2],
         time: f64,
         dt: f64,
     ) {
         let body = &mut self.bodies[b];
         let s = body.state;
-        let (force, torque) = (
+        let (force, torque): (Vec3, Vec3) = (
             std::array::from_fn(|d| impulse[d] / dt - applied[0][d]),
             std::array::from_fn(|d| angular_impulse[d] / dt - applied[1][d]),
         );
@@ -426,28 +490,25 @@ impl Bodies {
                 ),
                 force,
                 torque,
+                resting: s.resting,
             };
+            if s.resting {
+                body.state.velocity =
+                    std::array::from_fn(|d| dt * (force[d] + load[0][d]) / body.mass);
+                body.state.angular_momentum =
+                    std::array::from_fn(|d| dt * (torque[d] + load[1][d]));
+            }
             return;
         }
-        // Eq. (14): the momentum balance; the trapezoid for the centre is exact under a
-        // constant force (free fall).
-        let velocity: Vec3 = std::array::from_fn(|d| s.velocity[d] + impulse[d] / body.mass);
-        let centre =
-            std::array::from_fn(|d| s.centre[d] + 0.5 * dt * (s.velocity[d] + velocity[d]));
-        let angular_momentum = std::array::from_fn(|d| s.angular_momentum[d] + angular_impulse[d]);
+        // Eq. (14): the momentum balance.
         body.state = RigidState {
-            velocity,
-            angular_momentum,
+            velocity: std::array::from_fn(|d| s.velocity[d] + impulse[d] / body.mass),
+            angular_momentum: std::array::from_fn(|d| s.angular_momentum[d] + angular_impulse[d]),
             force,
             torque,
             ..s
         };
-        // Eq. (15)–(16): turn by ωⁿ⁺¹ Δt.
-        let w = body.angular_velocity();
-        body.state.orientation = Quaternion::from_rotation_vector(w.map(|w| w * dt))
-            .then_after(s.orientation)
-            .normalised();
-        body.state.centre = centre;
+        body.drift(s.velocity, dt);
     }
 }
 
@@ -551,4 +612,34 @@ pub(crate) fn outward_normal(
 pub fn rigid_velocity(velocity: Vec3, omega: Vec3, arm: Vec3) -> Vec3 {
     let w = cross(omega, arm);
     std::array::from_fn(|d| velocity[d] + w[d])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(resting: bool) -> RigidState {
+        RigidState {
+            centre: [0.1, 0.2, 0.3],
+            orientation: Quaternion([0.6, 0.0, 0.0, 0.8]),
+            velocity: [1.0, 2.0, 3.0],
+            angular_momentum: [4.0, 5.0, 6.0],
+            force: [7.0, 8.0, 9.0],
+            torque: [10.0, 11.0, 12.0],
+            resting,
+        }
+    }
+
+    #[test]
+    fn a_state_reads_back_from_its_checkpoint_array_and_an_older_one_rests_not() {
+        for resting in [false, true] {
+            let a = state(resting).to_array();
+            assert_eq!(RigidState::from_array(&a), state(resting));
+            // A checkpoint written before `resting` held the first 19.
+            assert_eq!(
+                RigidState::from_array(&a[..RigidState::LEN - 1]),
+                state(false)
+            );
+        }
+    }
 }

@@ -7,6 +7,9 @@
 //! takes the new one off, so the solve leaves the body at its rigid velocity up to the change
 //! of ∇P over a step, and the fluid around it sees a body that is held, not one that yields
 //! to the pressure and is put back each step (which stirs still water around a fixed body).
+//! A body resting on its supports is held so (`bodies::contact`); the body forces on its own
+//! masses, which its supports must hold with the fluid's force, are summed apart
+//! (`resting_loads`).
 //! The predictor adds f_i (Eq. 5), the wall ghosts carry it, and `rigid_bodies` takes its sums
 //! over each body out of the fluid's force.
 //! Runs only in a scene with bodies or a moving container.
@@ -15,9 +18,10 @@ use super::corrector::pressure_gradient;
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
 use crate::bodies::{rigid_velocity, Bodies};
-use crate::boundary::moving_frame::MovingFrame;
+use crate::boundary::moving_frame::{FrameForce, MovingFrame};
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_vector;
+use crate::math::rotation::{cross, Vec3};
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Kind, Particles};
 use crate::sph::interface;
@@ -27,6 +31,8 @@ pub const NAME: &str = "body forces";
 pub struct BodyForces<const D: usize> {
     frame: Option<MovingFrame>,
     force: [Vec<f64>; D],
+    /// The wall ghosts' body force where a body is held (`ghost`), else empty.
+    ghost: [Vec<f64>; D],
 }
 
 impl<const D: usize> BodyForces<D> {
@@ -35,12 +41,14 @@ impl<const D: usize> BodyForces<D> {
         Self {
             frame,
             force: components(),
+            ghost: components(),
         }
     }
 
-    /// f_i of the `nf` fluid and body particles over the step of `dt` from `time`; the last
-    /// step's pressure gradient at a held body's particles is taken with `surface`'s roles and
-    /// corrections across `interfaces`.
+    /// f_i of the `nf` fluid and body particles over the step of `dt` from `time` (`force`), and
+    /// the body force their wall ghosts carry (`ghost`); the last step's pressure gradient at a
+    /// held body's particles is taken with `surface`'s roles and corrections across
+    /// `interfaces`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -53,16 +61,12 @@ impl<const D: usize> BodyForces<D> {
         time: f64,
         dt: f64,
         nf: usize,
-    ) -> &[Vec<f64>; D] {
+    ) {
         for a in &mut self.force {
             a.resize(nf, 0.0);
         }
         let frame = self.frame.as_ref().map(|f| f.at(time));
-        let ghosts = set.ghost_force(None);
-        let ambient = |i: usize| match &frame {
-            Some(frame) => frame.at(p.position(i), p.velocity(i)),
-            None => set.gravity,
-        };
+        let ambient = |i: usize| ambient(frame.as_ref(), set, p, i);
         let targets: Vec<_> = bodies
             .bodies
             .iter()
@@ -82,6 +86,7 @@ impl<const D: usize> BodyForces<D> {
                 Some((target, rotation)) => {
                     let arm = bodies.bodies[b].arm(rotation, p.id[i]);
                     let u = rigid_velocity(target.velocity, target.angular_velocity, arm);
+                    let ghosts = set.ghost_force_of(ambient(i));
                     let grad =
                         pressure_gradient(nb, p, &p.pressure, surface, ghosts, interfaces, i);
                     let rho0 = p.rest_density[i];
@@ -93,7 +98,104 @@ impl<const D: usize> BodyForces<D> {
                 }
             }
         });
+        let held = |i: usize| p.kind[i] == Kind::Body && targets[p.fluid[i] as usize].is_some();
+        let any_held = targets.iter().any(Option::is_some);
+        for a in &mut self.ghost {
+            a.resize(if any_held { nf } else { 0 }, 0.0);
+        }
+        if any_held {
+            let force = &self.force;
+            fill_vector(&mut self.ghost, |i| {
+                if held(i) {
+                    ambient(i)
+                } else {
+                    std::array::from_fn(|d| force[d][i])
+                }
+            });
+        }
+    }
+
+    /// f_i of the last `run`: what the predictor adds.
+    pub fn force(&self) -> &[Vec<f64>; D] {
         &self.force
+    }
+
+    /// The body force the wall ghosts' pressures carry beside each particle of the last `run`
+    /// (`ghosts`): f_i, but at a held body's particles the body force of the water it stands
+    /// for (gravity, or the frame's), not the one that holds it. The ghosts carry the hydrostatic
+    /// pressure into the wall where a held body touches it, as they would the water's, so the
+    /// water's pressure through a body lying on the floor holds it up as it holds the water:
+    /// with the holding force there (the last step's ∇P/ρ0 and no gravity), the pressure at the
+    /// floor under the body only kept its last gradient, and a body resting on the floor of a
+    /// surge felt its buoyancy turned into a downward pull.
+    pub fn ghost(&self) -> &[Vec<f64>; D] {
+        if self.ghost[0].is_empty() {
+            &self.force
+        } else {
+            &self.ghost
+        }
+    }
+
+    /// The body forces of the step from `time` on each resting body's particles at their own
+    /// masses m_i, as on a free body's (gravity and its external force, in a moving container
+    /// the frame's): Σ m_i f_i and Σ r_ic × m_i f_i, what its supports hold against with the
+    /// fluid's force (`Bodies::advance`); zeros for a body that does not rest. Sums over the
+    /// `nf` fluid and body particles in index order.
+    pub fn resting_loads(
+        &self,
+        p: &Particles<D>,
+        bodies: &Bodies,
+        set: &StepSettings<D>,
+        time: f64,
+        nf: usize,
+    ) -> Vec<[Vec3; 2]> {
+        let mut loads = vec![[[0.0; 3]; 2]; bodies.bodies.len()];
+        if bodies.bodies.iter().all(|b| !b.state.resting) {
+            return loads;
+        }
+        let frame = self.frame.as_ref().map(|f| f.at(time));
+        for i in (0..nf).filter(|&i| p.kind[i] == Kind::Body) {
+            let b = p.fluid[i] as usize;
+            let body = &bodies.bodies[b];
+            if !body.state.resting {
+                continue;
+            }
+            let f = ambient(frame.as_ref(), set, p, i);
+            let mf: Vec3 = std::array::from_fn(|d| {
+                if d < D {
+                    body.particle_mass * (f[d] + body.external_force[d] / body.mass)
+                } else {
+                    0.0
+                }
+            });
+            let arm: Vec3 = std::array::from_fn(|d| {
+                if d < D {
+                    p.pos[d][i] - body.state.centre[d]
+                } else {
+                    0.0
+                }
+            });
+            let torque = cross(arm, mf);
+            for d in 0..3 {
+                loads[b][0][d] += mf[d];
+                loads[b][1][d] += torque[d];
+            }
+        }
+        loads
+    }
+}
+
+/// The body force on particle i where it is not a held body's: gravity, or in a moving
+/// container the frame's at its position and velocity.
+fn ambient<const D: usize>(
+    frame: Option<&FrameForce>,
+    set: &StepSettings<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> [f64; D] {
+    match frame {
+        Some(frame) => frame.at(p.position(i), p.velocity(i)),
+        None => set.gravity,
     }
 }
 
@@ -108,10 +210,13 @@ impl<const D: usize> Stage<D> for BodyForces<D> {
         } else {
             "gravity"
         };
-        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass; on a fixed or prescribed body's the acceleration to its rigid velocity at the step's end plus the last step's ∇P/ρ0")
+        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass; on a fixed, prescribed or resting body's the acceleration to its rigid velocity at the step's end plus the last step's ∇P/ρ0, and a resting body's own weight and external force for its supports")
     }
 
     fn arrays(&self) -> Vec<ArraySize> {
-        vec![ArraySize::of_components("body force", &self.force)]
+        vec![
+            ArraySize::of_components("body force", &self.force),
+            ArraySize::of_components("wall ghosts' body force beside held bodies", &self.ghost),
+        ]
     }
 }

@@ -30,8 +30,8 @@ impl<const D: usize> Default for Corrector<D> {
 }
 
 impl<const D: usize> Corrector<D> {
-    /// uⁿ⁺¹ of the fluid particles from `u_star`, which then holds ∇Pⁿ⁺¹; `force` is the body
-    /// force field where it is not gravity alone (`body_forces`).
+    /// uⁿ⁺¹ of the fluid particles from `u_star`, which then holds ∇Pⁿ⁺¹; `ghost` is the body
+    /// force the wall ghosts carry where it is not gravity alone (`body_forces`).
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -41,7 +41,7 @@ impl<const D: usize> Corrector<D> {
         faces: &Faces,
         surface: &Surface<D>,
         interfaces: Option<interface::Field<D>>,
-        force: Option<&[Vec<f64>; D]>,
+        ghost: Option<&[Vec<f64>; D]>,
         u_star: &mut [Vec<f64>; D],
         dt: f64,
     ) -> &[Vec<f64>; D] {
@@ -50,7 +50,7 @@ impl<const D: usize> Corrector<D> {
             a.resize(n, 0.0);
         }
         let touch = faces::touching_distance(set.spacing);
-        let ghost = set.ghost_force(force);
+        let ghost = set.ghost_force(ghost);
         fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
             let grad = pressure_gradient(nb, p, &p.pressure, surface, ghost, interfaces, i);
             let rho0 = p.rest_density[i];

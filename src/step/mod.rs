@@ -100,6 +100,15 @@ impl<const D: usize> StepSettings<D> {
         }
     }
 
+    /// The body force the wall ghosts' pressures beside a particle whose body force is `f`
+    /// carry (zero with mirror ghosts).
+    pub fn ghost_force_of(&self, f: [f64; D]) -> BodyForce<'static, D> {
+        match self.ghost_pressure {
+            GhostPressure::Mirror => BodyForce::Uniform([0.0; D]),
+            GhostPressure::Hydrostatic => BodyForce::Uniform(f),
+        }
+    }
+
     /// The body force the predictor adds: `field` where it varies, else gravity.
     pub fn body_force<'a>(&self, field: Option<&'a [Vec<f64>; D]>) -> BodyForce<'a, D> {
         field.map_or(BodyForce::Uniform(self.gravity), BodyForce::Field)
@@ -344,12 +353,17 @@ impl<const D: usize> Step<D> {
                 laps.lap(eddy_viscosity::NAME);
                 eddy
             });
-            let force = self.body_forces.as_mut().map(|stage| {
+            let loads = match &self.body_forces {
+                Some(stage) => stage.resting_loads(p, bodies, set, time, nf),
+                None => Vec::new(),
+            };
+            if let Some(stage) = &mut self.body_forces {
                 let surface = self.free_surface.output();
-                let force = stage.run(&nb, p, bodies, set, &surface, interfaces, time, dt, nf);
+                stage.run(&nb, p, bodies, set, &surface, interfaces, time, dt, nf);
                 laps.lap(body_forces::NAME);
-                force
-            });
+            }
+            let force = self.body_forces.as_ref().map(|stage| stage.force());
+            let ghost = self.body_forces.as_ref().map(|stage| stage.ghost());
             let u_star = self
                 .predictor
                 .run(&nb, p, set, eddy, set.body_force(force), dt, nf);
@@ -372,7 +386,7 @@ impl<const D: usize> Step<D> {
                     surface,
                     corrections,
                     interfaces,
-                    force,
+                    ghost,
                     u_star,
                     length,
                     probe,
@@ -392,7 +406,7 @@ impl<const D: usize> Step<D> {
                 &self.faces,
                 &surface,
                 interfaces,
-                force,
+                ghost,
                 u_star,
                 dt,
             );
@@ -400,7 +414,7 @@ impl<const D: usize> Step<D> {
             laps.lap(corrector::NAME);
             let velocity = self.corrector.velocity_scratch();
             if let (Some(stage), Some(force)) = (&mut self.rigid_bodies, force) {
-                stage.run(&nb, p, bodies, force, velocity, time, dt);
+                stage.run(&nb, p, bodies, force, &loads, velocity, time, dt);
                 laps.lap(rigid_bodies::NAME);
             }
             // Into the particles: uⁿ⁺¹ (the bodies' rigid).
@@ -412,7 +426,7 @@ impl<const D: usize> Step<D> {
                 let ghosts = ghosts::Ghosts {
                     rest_density: &p.rest_density,
                     normal: &p.normal,
-                    force: set.ghost_force(force),
+                    force: set.ghost_force(ghost),
                 };
                 // Into the particles: the walls' P, for the frame.
                 self.wall_pressure.run(&nb, &ghosts, &mut p.pressure, nf);

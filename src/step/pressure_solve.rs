@@ -69,7 +69,8 @@ impl<const D: usize> PressureSolve<D> {
 
     /// Solves for Pⁿ⁺¹ from u* (`u_star`), and with α > 0 for P_α from the density error,
     /// with the roles of `surface` (sealed regions are pinned there), the divergence corrected
-    /// by `corrections`; `probe`, if any, is handed the operator first. The report sums both
+    /// by `corrections`, the wall ghosts carrying `ghost` where the body force varies
+    /// (`body_forces`); `probe`, if any, is handed the operator first. The report sums both
     /// solves' iterations and keeps the larger residual.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
@@ -80,7 +81,7 @@ impl<const D: usize> PressureSolve<D> {
         surface: &mut FreeSurface<D>,
         corrections: Corrections<D>,
         interfaces: Option<interface::Field<D>>,
-        force: Option<&[Vec<f64>; D]>,
+        ghost: Option<&[Vec<f64>; D]>,
         u_star: &[Vec<f64>; D],
         step: StepLength,
         probe: Option<&mut dyn FnMut(&PressureOperator<D>)>,
@@ -104,7 +105,7 @@ impl<const D: usize> PressureSolve<D> {
             set,
             surface,
             interfaces,
-            force,
+            ghost,
             |op, mg, sealed, s| {
                 if let Some(probe) = probe {
                     probe(op);
@@ -181,7 +182,7 @@ fn with_operator<const D: usize, R>(
     set: &StepSettings<D>,
     surface: &mut FreeSurface<D>,
     interfaces: Option<interface::Field<D>>,
-    force: Option<&[Vec<f64>; D]>,
+    ghost: Option<&[Vec<f64>; D]>,
     solve: impl FnOnce(
         &PressureOperator<D>,
         &mut Multigrid<D>,
@@ -215,7 +216,7 @@ fn with_operator<const D: usize, R>(
             row_vectors: &rows.row_vectors,
             fluid_volume: &rows.fluid_volume,
             gravity: set.gravity,
-            ghost_force: set.ghost_force(force),
+            ghost_force: set.ghost_force(ghost),
             interfaces,
         };
         multigrid.setup(&op)?;

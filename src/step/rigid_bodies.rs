@@ -21,8 +21,9 @@ pub struct RigidBodies {
 impl RigidBodies {
     /// Advances `bodies` over the step of `dt` from `time` from `velocity`, the corrector's
     /// uⁿ⁺¹ of the `nf` fluid and body particles, and puts their rigid velocities there;
-    /// `force` is the body force f_i the predictor gave them (`body_forces`). The sums run over
-    /// the particles in the sorted order, one thread: the same bits whatever the thread count.
+    /// `force` is the body force f_i the predictor gave them and `loads` the body forces on the
+    /// resting bodies' own masses (`body_forces`). The sums run over the particles in the sorted
+    /// order, one thread: the same bits whatever the thread count.
     #[allow(clippy::too_many_arguments)]
     pub fn run<const D: usize>(
         &mut self,
@@ -30,6 +31,7 @@ impl RigidBodies {
         p: &Particles<D>,
         bodies: &mut Bodies,
         force: &[Vec<f64>; D],
+        loads: &[[Vec3; 2]],
         velocity: &mut [Vec<f64>; D],
         time: f64,
         dt: f64,
@@ -83,9 +85,9 @@ impl RigidBodies {
                 impulse[b] = applied[b][0].map(|f| f * dt);
                 angular[b] = applied[b][1].map(|t| t * dt);
             }
-            bodies.advance(b, impulse[b], angular[b], applied[b], time, dt);
+            bodies.advance(b, impulse[b], angular[b], applied[b], loads[b], time, dt);
         }
-        bodies.resolve_contacts(time);
+        bodies.resolve_contacts(time, dt);
         let poses: Vec<_> = bodies
             .bodies
             .iter()
@@ -155,7 +157,7 @@ impl<const D: usize> Stage<D> for RigidBodies {
     }
 
     fn describe(&self, _: &StepSettings<D>) -> String {
-        "Eq. (11)–(16): each free body's momentum and angular momentum from its particles' corrected velocities; V, L, the centre (trapezoid) and the orientation quaternion advanced in f64; contact with the container's faces; a fixed or prescribed body put where its motion says, the fluid's force on it measured; the particles' velocities and positions set rigidly".into()
+        "Eq. (11)–(16): each free body's momentum and angular momentum from its particles' corrected velocities; V, L, the centre (trapezoid) and the orientation quaternion advanced in f64; contact with the container's faces, obstacles and other bodies; a body its contacts stop rests, held still while they hold it; a fixed or prescribed body put where its motion says, the fluid's force on it measured; the particles' velocities and positions set rigidly".into()
     }
 
     fn arrays(&self) -> Vec<ArraySize> {
