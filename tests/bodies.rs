@@ -578,6 +578,67 @@ fn a_heavy_body_resting_on_the_floor_stays_at_rest_and_leaves_the_water_still() 
     }
 }
 
+/// The tilt [degrees] of a tank tilted to 10° along a half-cosine ramp over 2 s, at time t.
+fn ramp_tilt(t: f64) -> f64 {
+    10.0 * 0.5 * (1.0 - (std::f64::consts::PI * t.clamp(0.0, 2.0) / 2.0).cos())
+}
+
+/// A box 0.08 × 0.04 m at s = 2 with friction `friction` on the floor of water 0.2 m deep in a
+/// tank tilted by `ramp_tilt`: bodies.csv of the run to `until`, frames every 0.01 s.
+fn box_on_a_tilting_floor(dir: &Path, friction: f64, until: f64) -> Vec<(f64, Vec<f64>)> {
+    let mut table = String::from("time,x,y,angle\n");
+    for k in -2..=40 {
+        let t = k as f64 * 0.05;
+        table += &format!("{t:?},0,0,{:?}\n", ramp_tilt(t));
+    }
+    table += "10.0,0,0,10.0\n";
+    std::fs::write(dir.join("tilt.csv"), table).unwrap();
+    let sections = format!("[container.trajectory]\npivot = [0.3, 0.0]\ntable = \"tilt.csv\"\n\n[[body]]\nshape = \"box\"\nmin = [0.26, 0.0]\nmax = [0.34, 0.04]\ndensity = 2000.0\nfriction = {friction:?}\n");
+    let path = dir.join("tilt.toml");
+    std::fs::write(&path, tank(2, 0.01, [0.6, 0.4, 0.0], 0.2, 0.01, &sections)).unwrap();
+    let scene = isph::scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let out = dir.join("out");
+    run_scene(&scene, &out, until);
+    rows(&out, 0)
+}
+
+#[test]
+fn a_box_on_a_tilting_floor_starts_to_slide_where_the_tilt_passes_its_friction_angle() {
+    // Coulomb: a body resting on a floor tilted by θ slides once tan θ > μ, in water as in air
+    // (its weight in the water gives both the pull along the floor and the normal force).
+    // Resting, it is held in the pressure solve and its contacts hold it while they can
+    // (`bodies::contact`, 3.). Measured: it starts at 6.2–6.3° at μ = 0.1 (5.7° asked; the
+    // water still sloshing up the ramp) and at 8.48–8.54° at μ = 0.15 (8.53°); at μ = 0.3
+    // (16.7°) it stays exactly where it was.
+    for friction in [0.1, 0.15] {
+        let dir = TempDir::new("bodies-tilt");
+        let rows = box_on_a_tilting_floor(dir.path(), friction, 2.0);
+        let k = rows
+            .iter()
+            .position(|r| r.1[VX].hypot(r.1[VY]) > 0.0)
+            .unwrap_or_else(|| panic!("μ = {friction}: it never slid"));
+        let (still, moving) = (ramp_tilt(rows[k - 1].0), ramp_tilt(rows[k].0));
+        let expected = friction.atan().to_degrees();
+        eprintln!("μ = {friction}: still at {still}°, sliding at {moving}° ({expected}° asked)");
+        assert!(
+            moving > expected && still < expected + 1.0,
+            "μ = {friction}: still at {still}°, sliding at {moving}°, against {expected}°"
+        );
+    }
+    let dir = TempDir::new("bodies-tilt");
+    let rows = box_on_a_tilting_floor(dir.path(), 0.3, 3.0);
+    // At rest from the first step on, where its contact stopped it.
+    let x0 = rows[1].1[0];
+    for (t, r) in &rows[1..] {
+        assert!(
+            r[VX] == 0.0 && r[VY] == 0.0 && r[0] == x0,
+            "μ = 0.3, t = {t}: moved to {} at {} m/s",
+            r[0],
+            r[VX].hypot(r[VY])
+        );
+    }
+}
+
 #[test]
 fn the_sinking_cylinder_keeps_near_the_band_of_its_two_references() {
     // scenes/sinking_cylinder_2d.toml (D/dx = 20): R = 1 m at s = 1.2 held half submerged for
