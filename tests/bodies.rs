@@ -272,11 +272,11 @@ friction = 0.5
         );
     }
     // Still: it rests, held by its contacts (`bodies::contact`, 3.), though the water its fall
-    // set sloshing still moves at 0.25 m/s. Measured on four trajectories (frames every 0.01,
-    // 0.02, 0.025 and 0.05 s): exactly at rest over 1.5–2 s on all four; before it rested,
-    // 0.0016–0.0072 m/s on average, and 0.015 with one contact impulse at the middle of the
-    // points that touch. The bound leaves room for the slosh to rock it on its lattice polygon
-    // past what its weight and friction hold, on another trajectory.
+    // set sloshing still moves at 0.25 m/s and now and then rocks it on its lattice polygon past
+    // what its weight and friction hold. Measured on four trajectories (frames every 0.01,
+    // 0.02, 0.025 and 0.05 s): 0, 3.9e-4, 0 and 0.9e-4 m/s on average over 1.5–2 s; before it
+    // rested, 0.0016–0.0072 m/s, and 0.015 with one contact impulse at the middle of the points
+    // that touch.
     let speed = late
         .iter()
         .map(|&k| rows[k].1[VX].hypot(rows[k].1[VY]))
@@ -549,10 +549,10 @@ fn a_heavy_body_resting_on_the_floor_stays_at_rest_and_leaves_the_water_still() 
     // contacts stop them they rest, held still in the pressure solve while their supports hold
     // them (`bodies::contact`, 3.), so the water beside them is as still as beside a body of
     // the water's density. Measured: exactly at rest throughout; the water's kinetic energy
-    // over 1–2 s 1.6e-7 J/m beside the box and 1.1e-7 beside the circle. Before bodies rested,
-    // the solve moved them by their excess weight every step and their contacts stopped them
-    // after: 0.0051 and 0.0067 J/m, the water moving at up to 0.18 and 0.29 m/s, the bodies at
-    // 0.0005 and 0.001 m/s on average.
+    // over 1–2 s at most 1.4e-8 J/m beside the box and 5.1e-8 beside the circle. Before bodies
+    // rested, the solve moved them by their excess weight every step and their contacts
+    // stopped them after: 0.0051 and 0.0067 J/m on average, the water moving at up to 0.18 and
+    // 0.29 m/s, the bodies at 0.0005 and 0.001 m/s on average.
     for (name, shape) in [
         (
             "box",
@@ -608,7 +608,7 @@ fn a_box_on_a_tilting_floor_starts_to_slide_where_the_tilt_passes_its_friction_a
     // (its weight in the water gives both the pull along the floor and the normal force).
     // Resting, it is held in the pressure solve and its contacts hold it while they can
     // (`bodies::contact`, 3.). Measured: it starts at 6.2–6.3° at μ = 0.1 (5.7° asked; the
-    // water still sloshing up the ramp) and at 8.48–8.54° at μ = 0.15 (8.53°); at μ = 0.3
+    // water still sloshing up the ramp) and at 8.59–8.64° at μ = 0.15 (8.53°); at μ = 0.3
     // (16.7°) it stays exactly where it was.
     for friction in [0.1, 0.15] {
         let dir = TempDir::new("bodies-tilt");
@@ -635,6 +635,48 @@ fn a_box_on_a_tilting_floor_starts_to_slide_where_the_tilt_passes_its_friction_a
             "μ = 0.3, t = {t}: moved to {} at {} m/s",
             r[0],
             r[VX].hypot(r[VY])
+        );
+    }
+}
+
+#[test]
+fn a_box_set_sliding_on_the_floor_stops_where_coulomb_friction_stops_it() {
+    // A box 0.08 × 0.04 m at s = 2 on the floor of still water 0.2 m deep, started along the
+    // floor at v0 = 0.3 m/s, friction μ = 0.3. The friction μ (W − B) is the one force on the
+    // body and the water it carries along that takes their momentum M v0 away (the water
+    // takes its share of the body's speed in the first step, the added mass, and keeps it as
+    // the body slows), so it stops at t = M v0 / (μ (W − B)) = 0.204 s. Measured: 0.20–0.21 s,
+    // after 0.021 m. While the walls' ghost pressures held up the body's own weight, its
+    // contact took little of it and the friction bound μ λ with it: it slid 0.038 m in 1 s and
+    // was still sliding.
+    let dir = TempDir::new("bodies-slide");
+    let body = "[[body]]\nshape = \"box\"\nmin = [0.16, 0.0]\nmax = [0.24, 0.04]\ndensity = 2000.0\nfriction = 0.3\nvelocity = [0.3, 0.0]\n";
+    let scene = scene_from_text(&tank(2, 0.01, [0.6, 0.4, 0.0], 0.2, 0.01, body));
+    run_scene(&scene, dir.path(), 0.5);
+    let rows = rows(dir.path(), 0);
+    let area = 0.08 * 0.04;
+    let (mass, excess) = (2000.0 * area, (2000.0 - 1000.0) * area * 9.81);
+    let expected = mass * 0.3 / (0.3 * excess);
+    let k = rows
+        .iter()
+        .position(|r| r.1[VX] == 0.0 && r.0 > 0.0)
+        .unwrap_or_else(|| panic!("still sliding at 0.5 s: {:?}", rows.last()));
+    eprintln!(
+        "stopped by {} s after {} m ({expected} s asked)",
+        rows[k].0,
+        rows[k].1[0] - rows[0].1[0]
+    );
+    assert!(
+        (rows[k - 1].0 - expected).abs() < 0.15 * expected,
+        "stopped between {} and {} s against {expected} s",
+        rows[k - 1].0,
+        rows[k].0
+    );
+    for (t, r) in &rows[k..] {
+        assert!(
+            r[VX] == 0.0 && r[VY] == 0.0,
+            "t = {t}: moving again at {}",
+            r[VX]
         );
     }
 }

@@ -389,6 +389,11 @@ impl Bodies {
         self.bodies.is_empty()
     }
 
+    /// The first fluid's rest density, which a held body takes in the pressure solve.
+    pub fn water_density(&self) -> f64 {
+        self.water_density
+    }
+
     /// Gives each body particle the mass and rest density the step from `time` takes it at:
     /// its body's own where the body moves freely, the water's (the first fluid's) with the
     /// same volume where it is held (fixed, prescribed or resting). A held body's motion does

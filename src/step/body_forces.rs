@@ -10,8 +10,9 @@
 //! A body resting on its supports is held so (`bodies::contact`); the body forces on its own
 //! masses, which its supports must hold with the fluid's force, are summed apart
 //! (`resting_loads`).
-//! The predictor adds f_i (Eq. 5), the wall ghosts carry it, and `rigid_bodies` takes its sums
-//! over each body out of the fluid's force.
+//! The predictor adds f_i (Eq. 5), the wall ghosts carry it (beside a body's particles the
+//! water's weight instead, `ghost`), and `rigid_bodies` takes its sums over each body out of the
+//! fluid's force.
 //! Runs only in a scene with bodies or a moving container.
 
 use super::corrector::pressure_gradient;
@@ -31,7 +32,7 @@ pub const NAME: &str = "body forces";
 pub struct BodyForces<const D: usize> {
     frame: Option<MovingFrame>,
     force: [Vec<f64>; D],
-    /// The wall ghosts' body force where a body is held (`ghost`), else empty.
+    /// The wall ghosts' body force in a scene with bodies (`ghost`), else empty.
     ghost: [Vec<f64>; D],
 }
 
@@ -98,21 +99,21 @@ impl<const D: usize> BodyForces<D> {
                 }
             }
         });
-        let held = |i: usize| p.kind[i] == Kind::Body && targets[p.fluid[i] as usize].is_some();
-        let any_held = targets.iter().any(Option::is_some);
+        if bodies.is_empty() {
+            return;
+        }
         for a in &mut self.ghost {
-            a.resize(if any_held { nf } else { 0 }, 0.0);
+            a.resize(nf, 0.0);
         }
-        if any_held {
-            let force = &self.force;
-            fill_vector(&mut self.ghost, |i| {
-                if held(i) {
-                    ambient(i)
-                } else {
-                    std::array::from_fn(|d| force[d][i])
-                }
-            });
-        }
+        let (force, water) = (&self.force, bodies.water_density());
+        fill_vector(&mut self.ghost, |i| {
+            if p.kind[i] == Kind::Body {
+                let f = ambient(i);
+                std::array::from_fn(|d| f[d] * water / p.rest_density[i])
+            } else {
+                std::array::from_fn(|d| force[d][i])
+            }
+        });
     }
 
     /// f_i of the last `run`: what the predictor adds.
@@ -121,13 +122,17 @@ impl<const D: usize> BodyForces<D> {
     }
 
     /// The body force the wall ghosts' pressures carry beside each particle of the last `run`
-    /// (`ghosts`): f_i, but at a held body's particles the body force of the water it stands
-    /// for (gravity, or the frame's), not the one that holds it. The ghosts carry the hydrostatic
-    /// pressure into the wall where a held body touches it, as they would the water's, so the
-    /// water's pressure through a body lying on the floor holds it up as it holds the water:
-    /// with the holding force there (the last step's ∇P/ρ0 and no gravity), the pressure at the
-    /// floor under the body only kept its last gradient, and a body resting on the floor of a
-    /// surge felt its buoyancy turned into a downward pull.
+    /// (`ghosts`): f_i, but beside a body's particle the water's weight, ρ_w/ρ0_i times the
+    /// body force of the water it stands for (gravity, or the frame's), not its own weight, its
+    /// external force nor the force that holds it. The walls then hold up through the pressure
+    /// solve what they hold of the water, and a body's weight in the water and its external
+    /// force reach a wall through its contact points, whose normal impulses bound its friction.
+    /// With its own weight in the ghosts, the solve carried most of a free body's weight to the
+    /// floor and its contact little, and a box set sliding along a floor at μ = 0.3 slid on past
+    /// where Coulomb friction stops it; with a held body's holding force there (the last step's
+    /// ∇P/ρ0 and no gravity), the pressure at the floor under it only kept its last gradient,
+    /// and a disc resting on the floor under a surge felt its buoyancy turned into a downward
+    /// pull (docs/bodies.md, "Contact").
     pub fn ghost(&self) -> &[Vec<f64>; D] {
         if self.ghost[0].is_empty() {
             &self.force
@@ -210,13 +215,13 @@ impl<const D: usize> Stage<D> for BodyForces<D> {
         } else {
             "gravity"
         };
-        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass; on a fixed, prescribed or resting body's the acceleration to its rigid velocity at the step's end plus the last step's ∇P/ρ0, and a resting body's own weight and external force for its supports")
+        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass; on a fixed, prescribed or resting body's the acceleration to its rigid velocity at the step's end plus the last step's ∇P/ρ0, and a resting body's own weight and external force for its supports; beside a body's particles the wall ghosts carry the water's weight, ρ_w f, not the body's")
     }
 
     fn arrays(&self) -> Vec<ArraySize> {
         vec![
             ArraySize::of_components("body force", &self.force),
-            ArraySize::of_components("wall ghosts' body force beside held bodies", &self.ghost),
+            ArraySize::of_components("wall ghosts' body force (the water's beside bodies)", &self.ghost),
         ]
     }
 }
