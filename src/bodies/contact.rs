@@ -19,10 +19,11 @@
 //!    Coulomb friction impulse along the sliding direction t that stops the sliding, at most
 //!    μ j.
 //! 2. **With a face or an obstacle**, a body moves out along n by δ (the same passes), and then
-//!    every particle within `SLOP` spacings of touching is a contact point, with the surface's
-//!    normal there. A body lying on a floor touches at many points, and one impulse at one
-//!    point would spin it about that point: a circle's lattice polygon, resting on its bottom
-//!    row, rocked on the floor that way. The impulses of all its points are found together by
+//!    every particle within `SLOP` spacings of touching a face, an obstacle or a body that
+//!    stands still (fixed, or resting) is a contact point, with the surface's normal there. A
+//!    body lying on a floor touches at many points, and one impulse at one point would spin it
+//!    about that point: a circle's lattice polygon, resting on its bottom row, rocked on the
+//!    floor that way. The impulses of all its points are found together by
 //!    projected Gauss–Seidel with accumulated impulses (sequential impulses, as in Box2D):
 //!    sweep after sweep over the points in order, each point's normal impulse λ ≥ 0 brings its
 //!    normal velocity apart to −e v_n⁰ if it approached at v_n⁰ < 0 before the solve and to 0
@@ -32,10 +33,11 @@
 //!    surface approaches it at up to that speed in every step, and would never come to rest.
 //! 3. **Resting.** A free body whose contact points' solve stops it (all but `HELD` of its
 //!    largest speed), one of them a support its weight in the water presses it onto (a heavy
-//!    body's floor, a light one's lid), rests: its velocity is set to zero, and over the next step it is held
-//!    where it is, as a fixed body is, so the pressure solve sees a body that does not move
-//!    (`RigidBody::target`). After that solve its velocity from rest is what the fluid's force
-//!    on the held body and its own body forces give it over the step (`Bodies::advance`), and
+//!    body's floor, a light one's lid), rests: its velocity is set to zero, and over the next
+//!    step it is held where it is, as a fixed body is, so the pressure solve sees a body that
+//!    does not move (`RigidBody::target`). After that solve its velocity from rest is what the
+//!    fluid's force on the held body and its own body forces give it over the step
+//!    (`Bodies::advance`), and
 //!    the same contact solve either stops it again (it stays at rest) or not: then its
 //!    supports cannot hold it (it is lifted, slides past its friction, or tips) and it moves
 //!    off with what the contacts leave it. This is static friction and the floor's reaction
@@ -44,7 +46,8 @@
 //!    it and jittering (docs/bodies.md, "Contact").
 //!
 //! e is the larger of the two restitutions, μ the geometric mean of the two frictions (as
-//! Box2D combines them); a face or an obstacle takes the body's own. Everything runs over the
+//! Box2D combines them); a face, an obstacle or a body that stands still takes the body's own
+//! at its contact points. Everything runs over the
 //! bodies, the pairs and the points in index order: the same bits whatever the thread count.
 
 use super::{outward_normal, Bodies, RigidBody};
@@ -158,7 +161,7 @@ impl Bodies {
         self.separate(&free);
         let bounce_above = dot(self.gravity, self.gravity).sqrt() * dt;
         for a in (0..self.bodies.len()).filter(|&a| free[a]) {
-            let mut points = self.contact_points(&self.bodies[a]);
+            let mut points = self.contact_points(a, time);
             let body = &mut self.bodies[a];
             let before = body.largest_speed();
             if !points.is_empty() {
@@ -249,11 +252,7 @@ impl Bodies {
     fn pair_touch(&self, a: usize, b: usize) -> Option<Touch> {
         let (ba, bb) = (&self.bodies[a], &self.bodies[b]);
         let gap = 0.5 * self.spacing;
-        let apart = (0..3)
-            .map(|d| (ba.state.centre[d] - bb.state.centre[d]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        if apart > ba.reach + bb.reach + 2.0 * gap {
+        if !within_reach(ba, bb, gap) {
             return None;
         }
         let dims = self.dims;
@@ -279,11 +278,13 @@ impl Bodies {
         }
     }
 
-    /// The contact points of `body` with the faces and the obstacles: its particles within
-    /// `SLOP` spacings of touching, with the surface's normal there.
-    fn contact_points(&self, body: &RigidBody) -> Vec<ContactPoint> {
+    /// The contact points of body a with the faces, the obstacles and the bodies that stand
+    /// still over the step from `time` (fixed, or resting): its particles within `SLOP`
+    /// spacings of touching, with the surface's normal there.
+    fn contact_points(&self, a: usize, time: f64) -> Vec<ContactPoint> {
         let (dims, gap) = (self.dims, 0.5 * self.spacing);
         let near = gap + SLOP * self.spacing;
+        let body = &self.bodies[a];
         let points = world_points(body);
         let mut found = Vec::new();
         for (d, plane, sign) in self.planes() {
@@ -291,12 +292,20 @@ impl Bodies {
                 found.push(ContactPoint::new(body, *x, axis(d, sign)));
             }
         }
-        for o in &self.obstacles {
-            let distance = |x: &Vec3| o.signed_distance(&x[..dims]);
+        let mut touching = |distance: &dyn Fn(&Vec3) -> f64| {
             for x in points.iter().filter(|x| distance(x) < near) {
-                if let Some(n) = outward_normal(&distance, *x, gap, dims) {
+                if let Some(n) = outward_normal(distance, *x, gap, dims) {
                     found.push(ContactPoint::new(body, *x, n));
                 }
+            }
+        };
+        for o in &self.obstacles {
+            touching(&|x: &Vec3| o.signed_distance(&x[..dims]));
+        }
+        for (b, support) in self.bodies.iter().enumerate() {
+            let still = support.state.resting || support.motion_at(time) == &BodyMotion::Fixed;
+            if b != a && still && within_reach(body, support, near) {
+                touching(&|x: &Vec3| support.surface_distance(x, dims));
             }
         }
         found
@@ -441,6 +450,16 @@ fn sliding(relative: Vec3, n: Vec3) -> Option<(Vec3, f64)> {
 /// yield to a contact).
 fn moves_freely(body: &RigidBody, time: f64) -> bool {
     matches!(body.motion_at(time), BodyMotion::Free)
+}
+
+/// Whether bodies a and b may be nearer than `gap`: their centres closer than their reaches
+/// and twice the gap.
+fn within_reach(a: &RigidBody, b: &RigidBody, gap: f64) -> bool {
+    let apart = (0..3)
+        .map(|d| (a.state.centre[d] - b.state.centre[d]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    apart <= a.reach + b.reach + 2.0 * gap
 }
 
 /// The unit vector along axis d with `sign`.

@@ -221,7 +221,10 @@ impl<const D: usize> Stage<D> for BodyForces<D> {
     fn arrays(&self) -> Vec<ArraySize> {
         vec![
             ArraySize::of_components("body force", &self.force),
-            ArraySize::of_components("wall ghosts' body force (the water's beside bodies)", &self.ghost),
+            ArraySize::of_components(
+                "wall ghosts' body force (the water's beside bodies)",
+                &self.ghost,
+            ),
         ]
     }
 }
