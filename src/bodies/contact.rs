@@ -37,18 +37,17 @@
 //!    step it is held where it is, as a fixed body is, so the pressure solve sees a body that
 //!    does not move (`RigidBody::target`). After that solve its velocity from rest is what the
 //!    fluid's force on the held body and its own body forces give it over the step
-//!    (`Bodies::advance`), and
-//!    the same contact solve either stops it again (it stays at rest) or not: then its
-//!    supports cannot hold it (it is lifted, slides past its friction, or tips) and it moves
-//!    off with what the contacts leave it. This is static friction and the floor's reaction
+//!    (`Bodies::advance`), and the same contact solve either stops it again (it stays at rest)
+//!    or not: then its supports cannot hold it (it is lifted, slides past its friction, or
+//!    tips) and it moves off with what the contacts leave it. This is static friction and the floor's reaction
 //!    acting within the step; without it the solve moved a body lying on the floor by its
 //!    excess weight in every step and its contact stopped it after, stirring the water beside
 //!    it and jittering (docs/bodies.md, "Contact").
 //!
 //! e is the larger of the two restitutions, μ the geometric mean of the two frictions (as
 //! Box2D combines them); a face, an obstacle or a body that stands still takes the body's own
-//! at its contact points. Everything runs over the
-//! bodies, the pairs and the points in index order: the same bits whatever the thread count.
+//! at its contact points. Everything runs over the bodies, the pairs and the points in index
+//! order: the same bits whatever the thread count.
 
 use super::{outward_normal, Bodies, RigidBody};
 use crate::math::rotation::{self, cross, Mat3, Vec3};
@@ -155,7 +154,7 @@ impl Motion {
 
 impl Bodies {
     /// Resolves the contacts of the bodies after their move over the step of `dt` from `time`,
-    /// and finds which rest on the faces and the obstacles (module doc, 3.).
+    /// and finds which rest on their contact points (module doc, 3.).
     pub fn resolve_contacts(&mut self, time: f64, dt: f64) {
         let free: Vec<bool> = self.bodies.iter().map(|b| moves_freely(b, time)).collect();
         self.separate(&free);
@@ -332,7 +331,7 @@ struct Bounce {
     above: f64,
 }
 
-/// The impulses of all of a body's contact points with the faces and the obstacles together,
+/// The impulses of all of a body's contact points (`Bodies::contact_points`) together,
 /// by projected Gauss–Seidel (module doc, 2.), with its `bounce` and `friction`.
 fn solve_contact_points(
     points: &mut [ContactPoint],

@@ -46,8 +46,9 @@ pub struct RigidState {
     /// the contacts' impulses).
     pub force: Vec3,
     pub torque: Vec3,
-    /// Whether a free body rests on the container's faces or the obstacles: held still over
-    /// the next step, as long as its contacts can hold it (`Bodies::resolve_contacts`).
+    /// Whether a free body rests on the container's faces, the obstacles or a body that stands
+    /// still: held still over the next step, as long as its contacts can hold it
+    /// (`Bodies::resolve_contacts`).
     pub resting: bool,
 }
 
