@@ -255,22 +255,12 @@ impl Bodies {
             return None;
         }
         let dims = self.dims;
-        let a_in_b = deepest_in(
-            &world_points(ba),
-            &|x| bb.surface_distance(x, dims),
-            gap,
-            dims,
-        );
-        let b_in_a = deepest_in(
-            &world_points(bb),
-            &|x| ba.surface_distance(x, dims),
-            gap,
-            dims,
-        )
-        .map(|t| Touch {
-            normal: t.normal.map(|n| -n),
-            ..t
-        });
+        let a_in_b = deepest_in(&world_points(ba), &bb.surface_distance(dims), gap, dims);
+        let b_in_a =
+            deepest_in(&world_points(bb), &ba.surface_distance(dims), gap, dims).map(|t| Touch {
+                normal: t.normal.map(|n| -n),
+                ..t
+            });
         match (a_in_b, b_in_a) {
             (Some(x), Some(y)) => Some(if x.depth >= y.depth { x } else { y }),
             (x, y) => x.or(y),
@@ -304,7 +294,7 @@ impl Bodies {
         for (b, support) in self.bodies.iter().enumerate() {
             let still = support.state.resting || support.motion_at(time) == &BodyMotion::Fixed;
             if b != a && still && within_reach(body, support, near) {
-                touching(&|x: &Vec3| support.surface_distance(x, dims));
+                touching(&support.surface_distance(dims));
             }
         }
         found

@@ -197,15 +197,16 @@ impl RigidBody {
         rotation::apply(&r, rotation::apply(&inverse, body_l))
     }
 
-    /// Signed distance of the world point x from the body's surface (negative inside), in a
-    /// `dims`-dimensional scene.
-    pub fn surface_distance(&self, x: &Vec3, dims: usize) -> f64 {
-        let arm: Vec3 = std::array::from_fn(|d| x[d] - self.state.centre[d]);
-        let local = rotation::apply_transposed(&self.rotation(), arm);
-        let at_start: Vec<f64> = (0..dims)
-            .map(|d| self.centre_at_start[d] + local[d])
-            .collect();
-        self.shape.signed_distance(&at_start)
+    /// The signed distance of a world point from the body's surface as it lies now (negative
+    /// inside), in a `dims`-dimensional scene: its rotation built once for every point asked.
+    pub fn surface_distance(&self, dims: usize) -> impl Fn(&Vec3) -> f64 + '_ {
+        let r = self.rotation();
+        move |x| {
+            let arm: Vec3 = std::array::from_fn(|d| x[d] - self.state.centre[d]);
+            let local = rotation::apply_transposed(&r, arm);
+            let at_start: Vec3 = std::array::from_fn(|d| self.centre_at_start[d] + local[d]);
+            self.shape.signed_distance(&at_start[..dims])
+        }
     }
 
     /// Offset of particle `id` from the centre, in the world frame, for rotation `r`.
@@ -537,7 +538,7 @@ impl Bodies {
                 if arm.iter().map(|a| a * a).sum::<f64>() > (body.reach + gap).powi(2) {
                     continue;
                 }
-                let surface = |y: &Vec3| body.surface_distance(y, dims);
+                let surface = body.surface_distance(dims);
                 let distance = surface(x);
                 if distance >= gap {
                     continue;

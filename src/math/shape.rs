@@ -45,10 +45,11 @@ impl Shape {
     pub fn signed_distance(&self, x: &[f64]) -> f64 {
         match self {
             Shape::Box { min, max } => {
-                let q: Vec<f64> = (0..x.len())
-                    .map(|d| (x[d] - 0.5 * (min[d] + max[d])).abs() - 0.5 * (max[d] - min[d]))
-                    .collect();
-                slab_distance(&q)
+                let mut q = [0.0; 3];
+                for d in 0..x.len() {
+                    q[d] = (x[d] - 0.5 * (min[d] + max[d])).abs() - 0.5 * (max[d] - min[d]);
+                }
+                slab_distance(&q[..x.len()])
             }
             Shape::Ball { center, radius } => distance(x, center) - radius,
             Shape::Cylinder {
