@@ -146,7 +146,10 @@ impl RigidBody {
     /// Whether the body is held over the step from t: fixed, prescribed, or resting on its
     /// supports (`RigidState::resting`).
     pub fn is_held(&self, t: f64) -> bool {
-        self.target(t, 0.0).is_some()
+        match self.motion_at(t) {
+            BodyMotion::Free => self.state.resting,
+            BodyMotion::Fixed | BodyMotion::Prescribed(_) => true,
+        }
     }
 
     /// The pose and velocities a held body (`is_held`) has at t + dt (None for a body that
