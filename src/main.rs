@@ -85,7 +85,9 @@ enum Command {
         /// Stop at this simulated time [s] instead of the scene's end_time.
         #[arg(long)]
         until: Option<f64>,
-        /// Continue even though the scene has changed since the checkpoint was written.
+        /// Continue even though the scene's settings have changed since the checkpoint was
+        /// written (not its particles: a changed spacing, fluid block, container, obstacle or
+        /// body is refused)
         #[arg(long)]
         force: bool,
         /// Scene file to use instead of the one the checkpoint names (e.g. after moving it).

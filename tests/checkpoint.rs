@@ -483,6 +483,98 @@ fn damaged_checkpoints_and_changed_scenes_are_refused_and_nothing_changes() {
 }
 
 #[test]
+fn a_forced_resume_into_a_scene_that_makes_other_particles_is_refused_and_nothing_changes() {
+    // `--force` continues a run whose settings changed; a body of another size, another
+    // spacing or a body less make other particles than the checkpoint holds (a body's offsets
+    // come from the scene's lattice), and are refused before the cut-back touches a file: an
+    // older checkpoint's later checkpoints, frames and rows stay.
+    let dir = TempDir::new("ckpt-other-particles");
+    let scene = dir.path().join("bodies.toml");
+    let text = r#"[simulation]
+dimensions = 2
+spacing = 0.02
+end_time = 0.1
+output_interval = 0.01
+gravity = [0.0, -9.81]
+
+[[fluid]]
+name = "water"
+density = 1000.0
+viscosity = 1.0e-6
+
+[[fluid_block]]
+fluid = "water"
+min = [0.0, 0.0]
+max = [0.4, 0.2]
+
+[container]
+min = [0.0, 0.0]
+max = [0.4, 0.4]
+
+[[body]]
+shape = "circle"
+center = [0.1, 0.3]
+radius = 0.05
+density = 500.0
+
+[[body]]
+shape = "circle"
+center = [0.3, 0.3]
+radius = 0.05
+density = 500.0
+
+[checkpoint]
+interval = 0.01
+keep = 5
+"#;
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.path().join("out");
+    let o = isph(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--until",
+        "0.04",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let oldest = checkpoint_folder::list(&checkpoint_folder::folder(&out)).unwrap()[0]
+        .1
+        .clone();
+    let refused = |changed: &str, target: &Path| {
+        std::fs::write(&scene, changed).unwrap();
+        let before = snapshot(&out);
+        let o = isph(&[
+            "resume",
+            target.to_str().unwrap(),
+            "--until",
+            "0.06",
+            "--force",
+            "-q",
+        ]);
+        assert_refused(&o, &["makes other particles", "bodies.toml", "no --force"]);
+        assert!(
+            snapshot(&out) == before,
+            "a refused resume changed the run's files"
+        );
+    };
+    refused(&text.replacen("radius = 0.05", "radius = 0.03", 1), &out);
+    refused(&text.replace("spacing = 0.02", "spacing = 0.025"), &out);
+    let one_body = text.replacen(
+        "[[body]]\nshape = \"circle\"\ncenter = [0.3, 0.3]\nradius = 0.05\ndensity = 500.0\n\n",
+        "",
+        1,
+    );
+    assert_ne!(one_body, text);
+    refused(&one_body, &oldest);
+    // The scene put back: the run continues.
+    std::fs::write(&scene, text).unwrap();
+    let o = isph(&["resume", oldest.to_str().unwrap(), "--until", "0.06", "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
 fn a_directory_resumes_from_its_newest_valid_checkpoint() {
     let dir = TempDir::new("ckpt-newest");
     let base = base_run(dir.path());

@@ -17,6 +17,7 @@ use crate::io::stats::StepStats;
 use crate::io::surface_files::SurfaceWriter;
 use crate::io::{prepare_output_dir, xdmf, OutputError};
 use crate::math::reduce::in_pool;
+use crate::particles::Particles;
 use crate::run::output::Output;
 use crate::run::progress::Progress;
 use crate::run::resume::{ResumeError, ResumeOptions};
@@ -168,10 +169,16 @@ fn resume_in<const D: usize>(
     checkpoint: &Checkpoint,
     opts: &ResumeOptions,
 ) -> Result<RunSummary, RunError> {
-    let start = resume::prepare(checkpoint, opts)?;
-    let mut sim = Simulation::<D>::new(&start.scene)?;
-    checkpoint.restore(&mut sim.particles)?;
+    // Every check, the particles' and the bodies' too, comes before the cut-back changes a
+    // file: a refused resume leaves the run as it was.
+    let checked = resume::check(checkpoint, opts)?;
+    let mut sim = Simulation::<D>::new(&checked.scene)?;
+    let mut restored = Particles::default();
+    checkpoint.restore(&mut restored)?;
+    resume::check_particles(checkpoint, &checked.scene.path, &sim.particles, &restored)?;
+    sim.particles = restored;
     checkpoint.restore_bodies(&mut sim.bodies)?;
+    let start = resume::cut_back(checked)?;
     sim.time = checkpoint.state.time;
     sim.step = checkpoint.state.step;
     Driver::new(

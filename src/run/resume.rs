@@ -10,6 +10,7 @@ use crate::io::probes::{self, ProbesWriter};
 use crate::io::stats::{self, StatsWriter};
 use crate::io::surface_files::{self, SurfaceWriter};
 use crate::io::{xdmf, OutputError};
+use crate::particles::{Kind, Particles};
 use crate::run::output::Output;
 use crate::run::stop::StopSignal;
 use crate::scene::{Scene, SceneError};
@@ -63,6 +64,12 @@ pub enum ResumeError {
         scene: PathBuf,
         now: usize,
         then: usize,
+    },
+    #[error("{scene} makes other particles than {checkpoint} holds ({what}): its spacing, fluid blocks, container, obstacles or bodies have changed since, and no --force can continue a run into other particles. Restore the scene, or start a new run")]
+    ParticlesChanged {
+        checkpoint: PathBuf,
+        scene: PathBuf,
+        what: String,
     },
     #[error("{checkpoint} is already at t = {time:?} s, not before the stop time {end:?} s; pass --until with a later time (or raise `end_time` in the scene)")]
     NothingToDo {
@@ -118,14 +125,22 @@ pub(crate) struct Continuation {
     pub output: Output,
 }
 
-/// Checks that `checkpoint` can be continued (its scene unchanged unless `force`, its run's
-/// frames and rows all there, a stop time after it), then cuts the run back to it: the
-/// checkpoints, frames and stats.csv, probes.csv and bodies.csv rows after it are deleted, particles.xdmf is
-/// rewritten.
-pub(crate) fn prepare(
-    checkpoint: &Checkpoint,
-    opts: &ResumeOptions,
-) -> Result<Continuation, ResumeError> {
+/// A checkpoint that `check` found can be continued, and what the cut-back will do; no file has
+/// changed yet.
+pub(crate) struct Checked {
+    pub scene: Scene,
+    out: PathBuf,
+    step: u64,
+    time: f64,
+    frames: Vec<frames::FrameInfo>,
+    stats_length: u64,
+    probes_file: ProbesFile,
+    bodies_length: Option<u64>,
+}
+
+/// Checks that `checkpoint` can be continued: its scene unchanged unless `force`, its run's
+/// frames and rows all there, a stop time after it. Changes no file.
+pub(crate) fn check(checkpoint: &Checkpoint, opts: &ResumeOptions) -> Result<Checked, ResumeError> {
     let state = &checkpoint.state;
     let path = checkpoint.path().to_owned();
     let out = output_dir(&path)?;
@@ -157,13 +172,36 @@ pub(crate) fn prepare(
         let frames = state.frames_written as usize;
         Some(bodies_csv::end_of_frames(&out, frames, scene.bodies.len())?)
     };
+    Ok(Checked {
+        scene,
+        out,
+        step: state.step,
+        time: state.time,
+        frames,
+        stats_length,
+        probes_file,
+        bodies_length,
+    })
+}
 
-    // Every check has passed: from here on the run's future after the checkpoint is replaced.
+/// Cuts the run of a `check`ed checkpoint back to it: the checkpoints, frames and stats.csv,
+/// probes.csv and bodies.csv rows after it are deleted, particles.xdmf is rewritten.
+pub(crate) fn cut_back(checked: Checked) -> Result<Continuation, ResumeError> {
+    let Checked {
+        scene,
+        out,
+        step,
+        time,
+        frames,
+        stats_length,
+        probes_file,
+        bodies_length,
+    } = checked;
     // particles.h5 is opened for writing first, so that if another program holds it, nothing
     // has changed yet.
     let frames_out = FrameWriter::open(&out)?;
     let folder = checkpoint_folder::folder(&out);
-    checkpoint_folder::remove_after(&folder, state.step).map_err(|source| OutputError::Write {
+    checkpoint_folder::remove_after(&folder, step).map_err(|source| OutputError::Write {
         path: folder.clone(),
         source,
     })?;
@@ -174,7 +212,7 @@ pub(crate) fn prepare(
         Some(settings) => Some((surfaces_from(&out, frames.len())?, settings)),
         None => None,
     };
-    let probes = continue_probes(&out, &scene, state, probes_file)?;
+    let probes = continue_probes(&out, &scene, step, time, probes_file)?;
     let bodies = bodies_length
         .map(|length| BodiesWriter::append_at(&out, length))
         .transpose()?;
@@ -190,6 +228,64 @@ pub(crate) fn prepare(
             bodies,
         },
     })
+}
+
+/// Checks that `restored`, the particles of `checkpoint`, are those the scene at `scene_path`
+/// makes (`fresh`, at t = 0): as many, each id of the same kind and
+/// fluid or body, the walls where they were. `--force` continues a run whose settings changed,
+/// never one whose particles did (a body's offsets and a fluid's lattice come from the scene).
+pub(crate) fn check_particles<const D: usize>(
+    checkpoint: &Checkpoint,
+    scene_path: &Path,
+    fresh: &Particles<D>,
+    restored: &Particles<D>,
+) -> Result<(), ResumeError> {
+    let changed = |what: String| ResumeError::ParticlesChanged {
+        checkpoint: checkpoint.path().to_owned(),
+        scene: scene_path.to_owned(),
+        what,
+    };
+    if fresh.len() != restored.len() {
+        return Err(changed(format!(
+            "{} particles against {}",
+            fresh.len(),
+            restored.len()
+        )));
+    }
+    let kind_name = |k: Kind| match k {
+        Kind::Fluid => "fluid",
+        Kind::Wall => "wall",
+        Kind::Body => "body",
+    };
+    let index = fresh.index_by_id();
+    for k in 0..restored.len() {
+        let (id, i) = (restored.id[k], index[restored.id[k] as usize] as usize);
+        let (then, now) = (restored.kind[k], fresh.kind[i]);
+        if then != now {
+            return Err(changed(format!(
+                "particle {id} is a {} particle in the scene, a {} particle in the checkpoint",
+                kind_name(now),
+                kind_name(then)
+            )));
+        }
+        if restored.fluid[k] != fresh.fluid[i] {
+            return Err(changed(format!(
+                "{} particle {id} belongs to {} {} in the scene, {} in the checkpoint",
+                kind_name(now),
+                if now == Kind::Body { "body" } else { "fluid" },
+                fresh.fluid[i],
+                restored.fluid[k]
+            )));
+        }
+        if now == Kind::Wall && (0..D).any(|d| restored.pos[d][k] != fresh.pos[d][i]) {
+            return Err(changed(format!(
+                "wall particle {id} is at {:?} in the scene, {:?} in the checkpoint",
+                fresh.position(i),
+                restored.position(k)
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// What becomes of a run's probes.csv on resume.
@@ -225,7 +321,8 @@ fn probes_file(out: &Path, scene: &Scene, state: &RunState) -> Result<ProbesFile
 fn continue_probes(
     out: &Path,
     scene: &Scene,
-    state: &RunState,
+    step: u64,
+    time: f64,
     file: ProbesFile,
 ) -> Result<Option<ProbesWriter>, OutputError> {
     match file {
@@ -233,16 +330,15 @@ fn continue_probes(
         ProbesFile::Start { set_aside } => {
             if set_aside {
                 let path = out.join(probes::FILE_NAME);
-                let aside = out.join(format!("probes_replaced_at_step_{}.csv", state.step));
+                let aside = out.join(format!("probes_replaced_at_step_{step}.csv"));
                 std::fs::rename(&path, &aside).map_err(|source| OutputError::Write {
                     path: aside.clone(),
                     source,
                 })?;
                 eprintln!(
-                    "warning: the scene's probes differ from those of {}: it is kept as {}, and probes.csv starts anew at t = {} s",
+                    "warning: the scene's probes differ from those of {}: it is kept as {}, and probes.csv starts anew at t = {time} s",
                     path.display(),
                     aside.display(),
-                    state.time
                 );
             }
             if scene.probes.is_empty() {
