@@ -434,6 +434,51 @@ fn each_bad_trajectory_is_refused_with_its_key() {
 }
 
 #[test]
+fn a_stop_time_past_the_end_of_a_motion_table_is_refused_before_anything_is_written() {
+    // After its last row a table holds its last pose, at rest: `--until` past it, on a run or a
+    // resume, would stop the prescribed motion dead. The table covers `end_time` (0.01 s).
+    let dir = TempDir::new("table-until");
+    std::fs::write(
+        dir.path().join("moves.csv"),
+        "time,x,y,angle\n0.0,0,0,0\n0.01,0.001,0,0\n",
+    )
+    .unwrap();
+    let body = "[[body]]\nshape = \"circle\"\ncenter = [0.05, 0.15]\nradius = 0.02\ndensity = 500.0\nmotion = \"prescribed\"\n[body.trajectory]\ntable = \"moves.csv\"";
+    let scene = format!("{}\n{body}\n", good());
+    let expected = [
+        "body[0].trajectory.table",
+        "moves.csv",
+        "ends at 0.01 s",
+        "0.02",
+    ];
+    let (code, stderr) = run_text(dir.path(), &scene, &["--until", "0.02"]);
+    assert_refused(code, &stderr, &expected);
+    assert!(
+        !dir.path().join("out").exists(),
+        "the refused run wrote {}",
+        dir.path().join("out").display()
+    );
+    let (code, stderr) = run_text(dir.path(), &scene, &[]);
+    assert_eq!(code, 0, "{stderr}");
+    let out = dir.path().join("out");
+    let before: Vec<_> = std::fs::read_dir(out.join("checkpoints"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    let o = isph(&["resume", out.to_str().unwrap(), "--until", "0.02", "-q"]);
+    assert_refused(
+        o.status.code().unwrap_or(-1),
+        &String::from_utf8_lossy(&o.stderr),
+        &expected,
+    );
+    let after: Vec<_> = std::fs::read_dir(out.join("checkpoints"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(before, after);
+}
+
+#[test]
 fn each_bad_mesh_is_refused_with_its_key() {
     let dir = TempDir::new("bad-meshes");
     // A cube with its top face missing: open.

@@ -64,6 +64,8 @@ pub enum RunError {
     Checkpoint(#[from] CheckpointError),
     #[error(transparent)]
     Resume(#[from] ResumeError),
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
     #[error("{failure}; the frames and statistics up to the last good step are in {}; {}", out.display(), last_good(last_checkpoint.as_ref(), out))]
     Numerical {
         failure: NumericalFailure,
@@ -127,6 +129,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<RunSummary, RunError> {
 }
 
 fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary, RunError> {
+    scene.check_tables_cover(opts.until.unwrap_or(scene.end_time))?;
     let sim = Simulation::<D>::new(scene)?;
     prepare_output_dir(&opts.out, opts.overwrite)?;
     let output = Output {

@@ -35,6 +35,8 @@ pub enum ResumeError {
     Checkpoint(#[from] CheckpointError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error(transparent)]
+    Coverage(#[from] SceneError),
     #[error("cannot read the checkpoints in {dir}: {source}")]
     Folder {
         dir: PathBuf,
@@ -146,6 +148,7 @@ pub(crate) fn check(checkpoint: &Checkpoint, opts: &ResumeOptions) -> Result<Che
     let out = output_dir(&path)?;
     let scene = load_scene(checkpoint, opts)?;
     let end = opts.until.unwrap_or(scene.end_time);
+    scene.check_tables_cover(end)?;
     if end <= state.time {
         return Err(ResumeError::NothingToDo {
             checkpoint: path,

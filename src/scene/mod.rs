@@ -207,6 +207,46 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Refuses a stop time `end` (`--until`) past the end of a motion table, the container's
+    /// or a prescribed body's before its release: after its last row a table holds its last
+    /// pose, at rest, and a run past it would stop the motion dead. Validation checks the
+    /// tables against `end_time`.
+    pub fn check_tables_cover(&self, end: f64) -> Result<(), SceneError> {
+        let container = self
+            .container_motion
+            .iter()
+            .map(|t| ("container.trajectory".to_string(), t, end));
+        let bodies = self
+            .bodies
+            .iter()
+            .enumerate()
+            .filter_map(|(k, b)| match &b.motion {
+                BodyMotion::Prescribed(t) => Some((
+                    format!("body[{k}].trajectory"),
+                    t,
+                    b.release.map_or(end, |r| r.min(end)),
+                )),
+                _ => None,
+            });
+        for (key, t, until) in container.chain(bodies) {
+            if let trajectory::Path::Table { file, rows } = &t.path {
+                let last = rows.last().map_or(0.0, |r| r.time);
+                if last < until {
+                    return Err(SceneError::Invalid {
+                        path: self.path.clone(),
+                        line: None,
+                        key: format!("{key}.table"),
+                        message: format!(
+                            "= \"{}\" ends at {last:?} s, before the stop time {end:?} s: the table must cover the whole run (extend it, or stop earlier)",
+                            file.display()
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Reads, parses and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
