@@ -186,6 +186,13 @@ fn hermite(rows: &[TableRow], t: f64) -> [[f64; 4]; 3] {
 /// and what is wrong with it.
 pub fn parse_table(text: &str, dims: usize) -> Result<Vec<TableRow>, (usize, String)> {
     let columns = dims + 2;
+    let header = text.lines().next().unwrap_or_default();
+    if !header.trim().is_empty() && header.split(',').all(|x| x.trim().parse::<f64>().is_ok()) {
+        return Err((
+            1,
+            "holds numbers where the header line belongs: the table starts with a line naming its columns (time, x, y[, z], angle), and its first row would otherwise be lost".into(),
+        ));
+    }
     let mut rows: Vec<TableRow> = Vec::new();
     for (k, line) in text.lines().enumerate().skip(1) {
         let line_no = k + 1;
@@ -276,13 +283,17 @@ mod tests {
     }
 
     #[test]
-    fn a_table_with_times_out_of_order_names_the_line() {
+    fn a_table_with_a_bad_line_names_it() {
         let err = parse_table("t,x,y,angle\n0,0,0,0\n0.1,0,0,1\n0.1,0,0,2\n", 2).unwrap_err();
         assert_eq!(err.0, 4);
         let err = parse_table("t,x,y,angle\n0,0,0\n", 2).unwrap_err();
         assert_eq!(err.0, 2);
         let err = parse_table("t,x,y,angle\n0.5,0,0,0\n1,0,0,0\n", 2).unwrap_err();
         assert!(err.1.contains("at or before t = 0"), "{}", err.1);
+        // A table without its header line would lose its first row.
+        let err = parse_table("0,0,0,0\n0.1,0,0,1\n0.2,0,0,2\n", 2).unwrap_err();
+        assert_eq!(err.0, 1);
+        assert!(err.1.contains("header line"), "{}", err.1);
     }
 
     #[test]
