@@ -167,19 +167,13 @@ impl RigidBody {
             BodyMotion::Prescribed(trajectory) => {
                 // The pivot moves by X and the body turns by θ about it (`scene::trajectory`).
                 let k = trajectory.at(t + dt);
-                let axis = trajectory.axis;
-                let orientation = Quaternion::from_rotation_vector(axis.map(|e| e * k.angle));
-                let rotation = orientation.matrix();
-                let pivot: Vec3 = std::array::from_fn(|d| trajectory.pivot[d] + k.displacement[d]);
-                let arm = rotation::apply(
-                    &rotation,
-                    std::array::from_fn(|d| self.centre_at_start[d] - trajectory.pivot[d]),
-                );
-                let angular_velocity = axis.map(|e| e * k.angular_velocity);
+                let placement = trajectory.placement(&k);
+                let arm = placement.arm(self.centre_at_start);
+                let angular_velocity = trajectory.axis.map(|e| e * k.angular_velocity);
                 let turn = cross(angular_velocity, arm);
                 Some(RigidTarget {
-                    centre: std::array::from_fn(|d| pivot[d] + arm[d]),
-                    orientation,
+                    centre: std::array::from_fn(|d| placement.pivot[d] + arm[d]),
+                    orientation: placement.orientation,
                     velocity: std::array::from_fn(|d| k.velocity[d] + turn[d]),
                     angular_velocity,
                 })

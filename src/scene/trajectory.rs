@@ -3,6 +3,7 @@
 //! (`[container.trajectory]`, sloshing) and a prescribed body (`[body.trajectory]`) move on one
 //! (docs/scene-format.md). The scene's geometry is the pose at t = 0: X(0) = 0 and θ(0) = 0.
 
+use crate::math::rotation::{self, Mat3, Quaternion, Vec3};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -39,6 +40,32 @@ pub enum Path {
         file: PathBuf,
         rows: Vec<TableRow>,
     },
+}
+
+/// A pose of a trajectory (`Trajectory::placement`).
+pub struct Placement {
+    /// The turn by θ about the axis, and its matrix.
+    pub orientation: Quaternion,
+    rotation: Mat3,
+    /// The pivot at t = 0, and where it has moved.
+    start: Vec3,
+    pub pivot: Vec3,
+}
+
+impl Placement {
+    /// R(θ)(x − pivot₀): the arm from the moved pivot to where the point at x at t = 0 is.
+    pub fn arm(&self, x: Vec3) -> Vec3 {
+        rotation::apply(
+            &self.rotation,
+            std::array::from_fn(|d| x[d] - self.start[d]),
+        )
+    }
+
+    /// Where the point at x at t = 0 is.
+    pub fn place(&self, x: Vec3) -> Vec3 {
+        let arm = self.arm(x);
+        std::array::from_fn(|d| self.pivot[d] + arm[d])
+    }
 }
 
 /// One row of a motion table: time [s], displacement [m] (z = 0 in 2D) and angle [rad].
@@ -99,6 +126,18 @@ impl Trajectory {
                     angular_acceleration: a[3],
                 }
             }
+        }
+    }
+
+    /// Where the motion at kinematics `k` (`at`) has taken what it moves: turned by θ about the
+    /// pivot, which has moved by X.
+    pub fn placement(&self, k: &Kinematics) -> Placement {
+        let orientation = Quaternion::from_rotation_vector(self.axis.map(|e| e * k.angle));
+        Placement {
+            orientation,
+            rotation: orientation.matrix(),
+            start: self.pivot,
+            pivot: std::array::from_fn(|d| self.pivot[d] + k.displacement[d]),
         }
     }
 

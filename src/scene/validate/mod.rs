@@ -804,6 +804,14 @@ impl Validator<'_> {
                 }
             };
             let motion = self.body_motion(b, &key, dims, &shape, s)?;
+            if let BodyMotion::Prescribed(trajectory) = &motion {
+                let particles: Vec<&Vec<f64>> =
+                    lattice.iter().filter(|x| shape.contains(x)).collect();
+                let until = b.release.map_or(s.end_time, |r| r.min(s.end_time));
+                self.prescribed_path_clear(
+                    trajectory, &particles, &key, &shape, container, obstacles, s.spacing, until,
+                )?;
+            }
             let force = b.force.clone().unwrap_or(vec![0.0; dims]);
             self.vector(&force, dims, &format!("{key}.force"))?;
             let restitution = b.restitution.unwrap_or(0.0);
@@ -865,6 +873,60 @@ impl Validator<'_> {
             });
         }
         Ok(bodies)
+    }
+
+    /// Refuses a prescribed body's trajectory that takes one of its `particles` (its lattice
+    /// points at t = 0) out of the container or within half a spacing of an obstacle before
+    /// `until`: neither yields to it. Sampled at `PATH_SAMPLES` times and every table row.
+    #[allow(clippy::too_many_arguments)]
+    fn prescribed_path_clear(
+        &self,
+        trajectory: &crate::scene::trajectory::Trajectory,
+        particles: &[&Vec<f64>],
+        key: &str,
+        shape: &Shape,
+        container: &Aabb,
+        obstacles: &[Aabb],
+        spacing: f64,
+        until: f64,
+    ) -> Result<(), SceneError> {
+        let dims = container.min.len();
+        let rows = match &trajectory.path {
+            crate::scene::trajectory::Path::Table { rows, .. } => {
+                rows.iter().map(|r| r.time).collect()
+            }
+            crate::scene::trajectory::Path::Sinusoid { .. } => Vec::new(),
+        };
+        let samples = (0..=PATH_SAMPLES).map(|j| until * j as f64 / PATH_SAMPLES as f64);
+        let mut times: Vec<f64> = samples
+            .chain(rows.into_iter().filter(|&t| (0.0..=until).contains(&t)))
+            .collect();
+        times.sort_by(f64::total_cmp);
+        let margin = 0.5 * spacing * (1.0 - 1e-9);
+        for t in times {
+            let placement = trajectory.placement(&trajectory.at(t));
+            for x in particles {
+                let at =
+                    placement.place(std::array::from_fn(|d| if d < dims { x[d] } else { 0.0 }));
+                let at = &at[..dims];
+                let inside = (0..dims).all(|d| {
+                    at[d] >= container.min[d] + margin && at[d] <= container.max[d] - margin
+                });
+                let key = format!("{key}.trajectory");
+                self.check(
+                    inside,
+                    &key,
+                    format!("takes the {} out of the container at t = {t:?} s (a particle to {at:?}): the container's walls do not yield to a prescribed body", shape.name(dims)),
+                )?;
+                if let Some(o) = obstacles.iter().position(|o| o.contains_within(at, margin)) {
+                    return Err(self.error(
+                        &key,
+                        format!("takes the {} into obstacle[{o}] at t = {t:?} s (a particle to {at:?}): an obstacle does not yield to a prescribed body", shape.name(dims)),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The motion of `[[body]]` section `b` with `shape`: a known name, and a trajectory for a
@@ -1142,6 +1204,10 @@ fn shape_keys_given(b: &ShapeSection) -> [(&'static str, bool); 7] {
 
 /// The lattice points of the scene's particle lattice (`fill`: container.min + (k + ½) dx)
 /// inside `bounds`.
+/// The times, evenly over the run, at which a prescribed body's path is checked
+/// (`prescribed_path_clear`), besides its table's rows.
+const PATH_SAMPLES: usize = 1000;
+
 fn lattice_points_in(bounds: &Aabb, container: &Aabb, spacing: f64) -> Vec<Vec<f64>> {
     let dims = bounds.min.len();
     let index = |d: usize, x: f64| ((x - container.min[d]) / spacing - 0.5).floor() as i64;
