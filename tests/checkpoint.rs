@@ -2,7 +2,7 @@
 //! a damaged checkpoint or a changed scene is refused with every file left as it was; SIGTERM
 //! stops a run with a checkpoint it resumes from.
 
-use crate::common::{isph_command, TempDir};
+use crate::common::{isph_command, tank, TempDir};
 use isph::io::checkpoint::Checkpoint;
 use isph::io::checkpoint_folder;
 use isph::particles::{ArrayMut, Kind, Particles};
@@ -490,43 +490,8 @@ fn a_forced_resume_into_a_scene_that_makes_other_particles_is_refused_and_nothin
     // older checkpoint's later checkpoints, frames and rows stay.
     let dir = TempDir::new("ckpt-other-particles");
     let scene = dir.path().join("bodies.toml");
-    let text = r#"[simulation]
-dimensions = 2
-spacing = 0.02
-end_time = 0.1
-output_interval = 0.01
-gravity = [0.0, -9.81]
-
-[[fluid]]
-name = "water"
-density = 1000.0
-viscosity = 1.0e-6
-
-[[fluid_block]]
-fluid = "water"
-min = [0.0, 0.0]
-max = [0.4, 0.2]
-
-[container]
-min = [0.0, 0.0]
-max = [0.4, 0.4]
-
-[[body]]
-shape = "circle"
-center = [0.1, 0.3]
-radius = 0.05
-density = 500.0
-
-[[body]]
-shape = "circle"
-center = [0.3, 0.3]
-radius = 0.05
-density = 500.0
-
-[checkpoint]
-interval = 0.01
-keep = 5
-"#;
+    let bodies = "[[body]]\nshape = \"circle\"\ncenter = [0.1, 0.3]\nradius = 0.05\ndensity = 500.0\n\n[[body]]\nshape = \"circle\"\ncenter = [0.3, 0.3]\nradius = 0.05\ndensity = 500.0\n\n[checkpoint]\ninterval = 0.01\nkeep = 5\n";
+    let text = &tank(2, 0.02, [0.4, 0.4, 0.0], 0.2, 0.01, bodies);
     std::fs::write(&scene, text).unwrap();
     let out = dir.path().join("out");
     let o = isph(&[
@@ -566,7 +531,7 @@ keep = 5
         "",
         1,
     );
-    assert_ne!(one_body, text);
+    assert_ne!(&one_body, text);
     refused(&one_body, &oldest);
     // The scene put back: the run continues.
     std::fs::write(&scene, text).unwrap();
