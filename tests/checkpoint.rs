@@ -352,17 +352,22 @@ fn base_run(dir: &Path) -> PathBuf {
     ];
     let scene = scene_file(dir, "dam_break_2d.toml", &edits, 0.005, 3);
     let out = dir.join("base");
+    run_until(&scene, &out, "0.02");
+    out
+}
+
+/// `isph run SCENE --out OUT --until UNTIL`, which must succeed.
+fn run_until(scene: &Path, out: &Path, until: &str) {
     let o = isph(&[
         "run",
         scene.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
         "--until",
-        "0.02",
+        until,
         "-q",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    out
 }
 
 fn newest_checkpoint(out: &Path) -> PathBuf {
@@ -494,16 +499,7 @@ fn a_forced_resume_into_a_scene_that_makes_other_particles_is_refused_and_nothin
     let text = &tank(2, 0.02, [0.4, 0.4, 0.0], 0.2, 0.01, bodies);
     std::fs::write(&scene, text).unwrap();
     let out = dir.path().join("out");
-    let o = isph(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--until",
-        "0.04",
-        "-q",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_until(&scene, &out, "0.04");
     let oldest = checkpoint_folder::list(&checkpoint_folder::folder(&out)).unwrap()[0]
         .1
         .clone();
