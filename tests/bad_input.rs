@@ -427,6 +427,7 @@ fn each_bad_trajectory_is_refused_with_its_key() {
         (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 0.04\namplitude = [0.3, 0.0]"), &["body[0].trajectory", "out of the container", "walls do not yield"]),
         (format!("[[obstacle]]\nmin = [0.25, 0.05]\nmax = [0.3, 0.15]\n\n{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 0.04\namplitude = [0.2, 0.0]"), &["body[0].trajectory", "into obstacle[0]", "does not yield"]),
         ("[container.trajectory]\nperiod = -1.0\nangle = 4.0".to_string(), &["container.trajectory.period", "positive"]),
+        ("[container.trajectory]\nperiod = 1.0".to_string(), &["container.trajectory", "gives no motion", "stands still"]),
         ("[container.trajectory]\nperiod = 1.0\nangle = 4.0\naxis = [0.0, 0.0, 1.0]".to_string(), &["container.trajectory.axis", "for 3D"]),
     ];
     for (text, expected) in cases {

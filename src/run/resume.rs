@@ -48,10 +48,12 @@ pub enum ResumeError {
     NoValidCheckpoint { dir: PathBuf, reasons: Vec<String> },
     #[error("{path} is not in the `{DIR_NAME}` folder of a run's output directory, so the run it continues cannot be found; move it back to OUT/{DIR_NAME}/")]
     OutsideRun { path: PathBuf },
-    #[error("cannot load the scene of checkpoint {checkpoint}: {source}; pass --scene FILE if the scene has moved")]
+    #[error("cannot load the scene of checkpoint {checkpoint}: {source}{}", if *given { "" } else { "; pass --scene FILE if the scene has moved" })]
     Scene {
         checkpoint: PathBuf,
         source: SceneError,
+        /// The scene was given with --scene.
+        given: bool,
     },
     #[error("{scene} has changed since {checkpoint} was written (the scene's hash is {now:#018x}, the checkpoint's {then:#018x}): a continuation would not be the run that was checkpointed. Restore the scene, or pass --force to continue with the scene as it is now")]
     SceneChanged {
@@ -389,6 +391,7 @@ fn load_scene(checkpoint: &Checkpoint, opts: &ResumeOptions) -> Result<Scene, Re
     let scene = Scene::load(&path).map_err(|source| ResumeError::Scene {
         checkpoint: checkpoint.path().to_owned(),
         source,
+        given: opts.scene.is_some(),
     })?;
     if scene.dimensions != checkpoint.dimensions() {
         return Err(ResumeError::Dimensions {

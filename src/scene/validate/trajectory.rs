@@ -64,10 +64,15 @@ impl Validator<'_> {
             axis: [0.0, 0.0, 1.0],
             path,
         };
+        let still = if key.starts_with("container") {
+            "leave it out: a container without a trajectory stands still"
+        } else {
+            "leave it out, or make the body `fixed`"
+        };
         self.check(
             trajectory.moves(),
             key,
-            "gives no motion (zero amplitude and angle): leave it out, or make the body `fixed`",
+            format!("gives no motion (zero amplitude and angle): {still}"),
         )?;
         let axis_key = format!("{key}.axis");
         match (&t.axis, dims) {
