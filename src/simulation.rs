@@ -48,7 +48,7 @@ pub enum NumericalFailure {
 }
 
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: the scene holds no fluid particle: every [[fluid_block]] is thinner than the spacing or lies inside obstacles")]
+#[error("{path}: the scene holds no fluid particle: every [[fluid_block]] is thinner than the spacing or lies inside obstacles and bodies")]
 pub struct NoFluid {
     pub path: std::path::PathBuf,
 }
