@@ -393,6 +393,7 @@ fn each_bad_body_is_refused_with_its_key() {
         ("shape = \"union\"\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\n[[body.part]]\nshape = \"union\"", &["body[0].part[1].shape", "\"union\" is not a shape a union's part takes"]),
         ("shape = \"union\"\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\n[[body.part]]\nshape = \"box\"\nmin = [0.1, 0.1]", &["body[0].part[1].max", "missing"]),
         ("shape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05", &["body[0].part", "is for a union"]),
+        ("shape = \"union\"\ndensity = 500.0\n[[body.part]]\nshape = \"circle\"\ncenter = [0.1, 0.1]\nradius = 0.05\n[[body.part]]\nshape = \"circle\"\ncenter = [0.2, 0.2]\nradius = 0.005", &["body[0].part[1].shape", "no lattice point", "adds nothing"]),
     ];
     for (text, expected) in cases {
         let (code, stderr) = run_text(dir.path(), &body(text), &[]);

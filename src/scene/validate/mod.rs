@@ -757,6 +757,20 @@ impl Validator<'_> {
                     s.spacing
                 ),
             )?;
+            if let Shape::Union(parts) = &shape {
+                // A part that holds no lattice point adds nothing to the body.
+                for (m, part) in parts.iter().enumerate() {
+                    self.check(
+                        lattice.iter().any(|x| part.contains(x)),
+                        &format!("{key}.part[{m}].shape"),
+                        format!(
+                            "the {} holds no lattice point of the spacing {:?} m and adds nothing to the union: make it larger than a spacing, or leave it out",
+                            part.name(dims),
+                            s.spacing
+                        ),
+                    )?;
+                }
+            }
             if let Some(o) = obstacles.iter().position(|o| {
                 lattice
                     .iter()
