@@ -917,6 +917,7 @@ impl Validator<'_> {
             .collect();
         times.sort_by(f64::total_cmp);
         let margin = 0.5 * spacing * (1.0 - 1e-9);
+        let key = format!("{key}.trajectory");
         for t in times {
             let placement = trajectory.placement(&trajectory.at(t));
             for x in particles {
@@ -926,12 +927,12 @@ impl Validator<'_> {
                 let inside = (0..dims).all(|d| {
                     at[d] >= container.min[d] + margin && at[d] <= container.max[d] - margin
                 });
-                let key = format!("{key}.trajectory");
-                self.check(
-                    inside,
-                    &key,
-                    format!("takes the {} out of the container at t = {t:?} s (a particle to {at:?}): the container's walls do not yield to a prescribed body", shape.name(dims)),
-                )?;
+                if !inside {
+                    return Err(self.error(
+                        &key,
+                        format!("takes the {} out of the container at t = {t:?} s (a particle to {at:?}): the container's walls do not yield to a prescribed body", shape.name(dims)),
+                    ));
+                }
                 if let Some(o) = obstacles.iter().position(|o| o.contains_within(at, margin)) {
                     return Err(self.error(
                         &key,
@@ -1216,12 +1217,12 @@ fn shape_keys_given(b: &ShapeSection) -> [(&'static str, bool); 7] {
     ]
 }
 
-/// The lattice points of the scene's particle lattice (`fill`: container.min + (k + ½) dx)
-/// inside `bounds`.
 /// The times, evenly over the run, at which a prescribed body's path is checked
 /// (`prescribed_path_clear`), besides its table's rows.
 const PATH_SAMPLES: usize = 1000;
 
+/// The lattice points of the scene's particle lattice (`fill`: container.min + (k + ½) dx)
+/// inside `bounds`.
 fn lattice_points_in(bounds: &Aabb, container: &Aabb, spacing: f64) -> Vec<Vec<f64>> {
     let dims = bounds.min.len();
     let index = |d: usize, x: f64| ((x - container.min[d]) / spacing - 0.5).floor() as i64;
