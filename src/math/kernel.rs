@@ -82,6 +82,8 @@ pub struct Kernel<const D: usize> {
     density_scale: f64,
     /// The smoothing length of the quintic of the same standard deviation (`width`).
     width: f64,
+    /// σ, the kernel's standard deviation along an axis (`deviation`).
+    deviation: f64,
 }
 
 impl<const D: usize> Kernel<D> {
@@ -109,11 +111,13 @@ impl<const D: usize> Kernel<D> {
             norm,
             density_scale: 1.0,
             width: h,
+            deviation: 0.0,
         };
+        kernel.deviation = h * kernel.deviation_over_h();
         if kind != KernelKind::Quintic {
             kernel.density_scale = 1.0 / kernel.lattice_sum(spacing);
             let quintic = Kernel::<D>::new(KernelKind::Quintic, 1.0, 1.0);
-            kernel.width = h * kernel.deviation_over_h() / quintic.deviation_over_h();
+            kernel.width = kernel.deviation / quintic.deviation_over_h();
         }
         kernel
     }
@@ -132,6 +136,12 @@ impl<const D: usize> Kernel<D> {
             second += shell * r * r;
         }
         (second / mass / D as f64).sqrt() / self.h
+    }
+
+    /// σ, with σ² = ∫ x² W dV the kernel's variance along an axis: the SPH Laplacian of Eq.
+    /// (26) falls short of a Fourier mode's by σ²|k|²/4 of it (`sph::field_laplacian`).
+    pub fn deviation(&self) -> f64 {
+        self.deviation
     }
 
     /// The smoothing length of the quintic with this kernel's standard deviation: h for the

@@ -91,6 +91,32 @@ pub fn viscous_acceleration<const D: usize>(
     acc.map(|a| a.total())
 }
 
+/// The SPH Laplacian of a vector field `f` of the fluid particles at fluid particle i, from its
+/// fluid neighbours: Eq. (26) with ν = 1 and the rest densities equal,
+/// Σ_j 2 V_j (f_i − f_j) r_ij·∇W_ij/(r_ij² + η²). For a Fourier mode of wave vector k it gives
+/// −|k|² (1 − σ²|k|²/4 + …) of the mode, σ the kernel's standard deviation
+/// (`Kernel::deviation`): in the integral form the symbol is 2∫ (1 − cos k·r) F dV, F = W'/r,
+/// and to fourth order in k·r, with ∫ rⁿ F dV = −(n + D − 2) ∫ rⁿ⁻² W dV and the angular means
+/// 1/D of (k̂·r̂)² and 3/(D (D + 2)) of (k̂·r̂)⁴, it is −|k|² + σ²|k|⁴/4 in any dimension D.
+pub fn field_laplacian<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    f: &[Vec<f64>; D],
+    i: usize,
+) -> [f64; D] {
+    let f_i: [F64s; D] = std::array::from_fn(|d| F64s::splat(f[d][i]));
+    let mut acc = [Sum::ZERO; D];
+    nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(l.r);
+        let c = (F64s::splat(2.0) * l.load(&p.mass) / l.load(&p.rest_density) * laplacian_factor)
+            & l.mask;
+        for d in 0..D {
+            acc[d] = acc[d].mul_add(c, f_i[d] - l.load(&f[d]));
+        }
+    });
+    acc.map(|a| a.total())
+}
+
 /// Corrected gradient of a velocity field, G[b][a] = ∂u_a/∂x_b = Σ_c L_bc Σ_j V_j (u_j − u_i)_a ∂_c
 /// W_ij (Eq. 20 with Eq. 24–25), with `u_i` the velocity of particle i and `u(l)` the velocities
 /// taken for the neighbours in lanes `l`.

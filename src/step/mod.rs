@@ -222,7 +222,7 @@ impl<const D: usize> Step<D> {
                 .then(kernel_correction::KernelCorrection::default),
             eddy_viscosity: effects.les.map(eddy_viscosity::EddyViscosity::new),
             body_forces: (bodies || frame.is_some()).then(|| body_forces::BodyForces::new(frame)),
-            predictor: predictor::Predictor::default(),
+            predictor: predictor::Predictor::new(&settings),
             hydrostatic_split: body_interfaces.then(hydrostatic_split::HydrostaticSplit::default),
             pressure_solve: pressure_solve::PressureSolve::new(settings.alpha > 0.0),
             corrector: corrector::Corrector::default(),
@@ -364,9 +364,16 @@ impl<const D: usize> Step<D> {
             }
             let force = self.body_forces.as_ref().map(|stage| stage.force());
             let ghost = self.body_forces.as_ref().map(|stage| stage.ghost());
-            let u_star = self
-                .predictor
-                .run(&nb, p, set, eddy, set.body_force(force), dt, nf);
+            let u_star = self.predictor.run(
+                &nb,
+                p,
+                set,
+                eddy,
+                set.body_force(force),
+                full_support,
+                dt,
+                nf,
+            );
             laps.lap(predictor::NAME);
             if let (Some(stage), Some(field), Some(force)) =
                 (&mut self.hydrostatic_split, interfaces, force)
