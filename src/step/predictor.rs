@@ -4,7 +4,7 @@
 //! `body_forces`.
 //!
 //! A laminar scene (no LES) takes the viscous term to second order in the step and fourth in
-//! the spacing where the kernel's support is all fluid: with a = νLuⁿ Eq. (26)'s acceleration and
+//! the spacing where the kernel's support holds one fluid only: with a = νLuⁿ Eq. (26)'s acceleration and
 //! L the SPH Laplacian (`sph::field_laplacian`),
 //!
 //!     u* = uⁿ + Δt (a + (ν Δt/2 − σ²/4) L a + f).
@@ -15,8 +15,8 @@
 //! σ²|k|⁴/4 (σ the kernel's standard deviation). Both are the one field L a, a second pair loop
 //! over the fluid. Without them a viscous Taylor–Green vortex at Re = 50 decayed too slowly and
 //! ended 1.4% of its energy above the exact one at 40 particles across (docs/accuracy.md, "The
-//! viscous operator"). Where the support reaches a wall, a body or the free surface, L a is
-//! truncated and the step keeps Euler's a. With LES the eddy viscosity is a model whose
+//! viscous operator"). Where the support reaches a wall, a body, another fluid or the free
+//! surface, L a is truncated or crosses a jump of a, and the step keeps Euler's a. With LES the eddy viscosity is a model whose
 //! constant dwarfs this error, and the pass is not run.
 
 use super::{Stage, StepSettings};
@@ -42,7 +42,8 @@ pub struct Predictor<const D: usize> {
 struct Laminar<const D: usize> {
     /// Eq. (26)'s viscous acceleration a of each fluid particle.
     viscous: [Vec<f64>; D],
-    /// Whether a fluid particle's support is all fluid (no wall, body or free surface in it).
+    /// Whether a fluid particle's support is all of its own fluid (no wall, body, other fluid or
+    /// free surface in it).
     fluid_support: Vec<bool>,
 }
 
@@ -115,7 +116,7 @@ impl<const D: usize> Predictor<D> {
 }
 
 impl<const D: usize> Laminar<D> {
-    /// a of Eq. (26) at every fluid particle, and whether its support is all fluid.
+    /// a of Eq. (26) at every fluid particle, and whether its support holds its own fluid only.
     fn run(
         &mut self,
         nb: &Neighbours<D>,
@@ -132,22 +133,29 @@ impl<const D: usize> Laminar<D> {
             let face = ghosts::nearest_face(nb, p, spacing, support, i);
             sph::viscous_acceleration(nb, p, None, face, i)
         });
-        let bodies = p.kind[..nf].contains(&Kind::Body);
+        // Bodies and a second fluid (another ν or ρ0: a jumps across the interface) are
+        // looked for only where the scene has them.
+        let mixed =
+            p.kind[..nf].contains(&Kind::Body) || p.fluid[..nf].iter().any(|&f| f != p.fluid[0]);
         self.fluid_support.resize(nf, false);
         fill(&mut self.fluid_support, |i| {
             full_support[i]
                 && p.kind[i] == Kind::Fluid
                 && ghosts::nearest_face(nb, p, spacing, support, i).is_none()
-                && !(bodies && touches_a_body(nb, p, i))
+                && !(mixed && touches_another_material(nb, p, i))
         });
     }
 }
 
-/// Whether a body particle lies in fluid particle i's support.
-fn touches_a_body<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> bool {
+/// Whether a body's particle or another fluid's lies in fluid particle i's support.
+fn touches_another_material<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> bool {
     let mut touches = false;
     nb.for_each_of(i, &[Kind::Fluid], |j, _, _| {
-        touches |= p.kind[j] == Kind::Body
+        touches |= p.kind[j] != Kind::Fluid || p.fluid[j] != p.fluid[i];
     });
     touches
 }
@@ -161,7 +169,7 @@ impl<const D: usize> Stage<D> for Predictor<D> {
         match set.effects.les {
             Some(les) if les.wall_function => "Eq. (5): u* = u + Δt (∇·((ν + ν_t)∇u) (Eq. 26) + τ_w + f), no-slip laminar wall pairs, τ_w the log-law wall shear on the particles touching a wall".into(),
             Some(_) => "Eq. (5): u* = u + Δt (∇·((ν + ν_t)∇u) (Eq. 26) + f), no-slip laminar wall pairs".into(),
-            None if self.laminar.is_some() => "Eq. (5): u* = u + Δt (a + (νΔt/2 − σ²/4) L a + f), a = ν∇²u of Eq. (26) with no-slip wall pairs, L a its SPH Laplacian where the support is all fluid (second order in Δt, the kernel's smoothing taken out)".into(),
+            None if self.laminar.is_some() => "Eq. (5): u* = u + Δt (a + (νΔt/2 − σ²/4) L a + f), a = ν∇²u of Eq. (26) with no-slip wall pairs, L a its SPH Laplacian where the support holds one fluid only (second order in Δt, the kernel's smoothing taken out)".into(),
             None => "Eq. (5): u* = u + Δt (∇·(ν∇u) (Eq. 26) + f), no-slip wall pairs".into(),
         }
     }
