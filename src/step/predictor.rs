@@ -3,9 +3,9 @@
 //! wall function) and f the body force: gravity, or where it varies the field of
 //! `body_forces`.
 //!
-//! A laminar scene (no LES) takes the viscous term to second order in the step and fourth in
-//! the spacing where the kernel's support holds one fluid only: with a = νLuⁿ Eq. (26)'s acceleration and
-//! L the SPH Laplacian (`sph::field_laplacian`),
+//! A laminar scene (no LES) takes the viscous term to second order in the step, and takes the
+//! kernel's smoothing out of it, where the kernel's support holds one fluid only: with
+//! a = νLuⁿ Eq. (26)'s acceleration and L the SPH Laplacian (`sph::field_laplacian`),
 //!
 //!     u* = uⁿ + Δt (a + (ν Δt/2 − σ²/4) L a + f).
 //!
@@ -16,8 +16,8 @@
 //! over the fluid. Without them a viscous Taylor–Green vortex at Re = 50 decayed too slowly and
 //! ended 1.4% of its energy above the exact one at 40 particles across (docs/accuracy.md, "The
 //! viscous operator"). Where the support reaches a wall, a body, another fluid or the free
-//! surface, L a is truncated or crosses a jump of a, and the step keeps Euler's a. With LES the eddy viscosity is a model whose
-//! constant dwarfs this error, and the pass is not run.
+//! surface, L a is truncated or crosses a jump of a, and the step keeps Euler's a. With LES the
+//! eddy viscosity is a model whose constant dwarfs this error, and the pass is not run.
 
 use super::{Stage, StepSettings};
 use crate::boundary::ghosts::{self, BodyForce};
