@@ -109,10 +109,10 @@ pub fn fill_vector_and_update<const D: usize>(
 
 /// (s[i], v[i]) ← f(i) for every i: a scalar and a vector per particle from one pass, the
 /// vector into the SoA components of `v`.
-pub fn fill_scalar_and_vector<const D: usize>(
-    s: &mut [f64],
+pub fn fill_scalar_and_vector<T: Send, const D: usize>(
+    s: &mut [T],
     v: &mut [Vec<f64>; D],
-    f: impl Fn(usize) -> (f64, [f64; D]) + Sync,
+    f: impl Fn(usize) -> (T, [f64; D]) + Sync,
 ) {
     assert_eq!(
         s.len(),

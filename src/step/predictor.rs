@@ -23,7 +23,7 @@ use super::{Stage, StepSettings};
 use crate::boundary::ghosts::{self, BodyForce};
 use crate::effects::les;
 use crate::math::memory::ArraySize;
-use crate::math::reduce::{fill, fill_vector};
+use crate::math::reduce::{fill_scalar_and_vector, fill_vector};
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Kind, Particles};
 use crate::sph;
@@ -129,20 +129,21 @@ impl<const D: usize> Laminar<D> {
         for a in &mut self.viscous {
             a.resize(nf, 0.0);
         }
-        fill_vector(&mut self.viscous, |i| {
-            let face = ghosts::nearest_face(nb, p, spacing, support, i);
-            sph::viscous_acceleration(nb, p, None, face, i)
-        });
+        self.fluid_support.resize(nf, false);
         // Bodies and a second fluid (another ν or ρ0: a jumps across the interface) are
         // looked for only where the scene has them.
         let mixed =
             p.kind[..nf].contains(&Kind::Body) || p.fluid[..nf].iter().any(|&f| f != p.fluid[0]);
-        self.fluid_support.resize(nf, false);
-        fill(&mut self.fluid_support, |i| {
-            full_support[i]
+        fill_scalar_and_vector(&mut self.fluid_support, &mut self.viscous, |i| {
+            let face = ghosts::nearest_face(nb, p, spacing, support, i);
+            let fluid_support = full_support[i]
                 && p.kind[i] == Kind::Fluid
-                && ghosts::nearest_face(nb, p, spacing, support, i).is_none()
-                && !(mixed && touches_another_material(nb, p, i))
+                && face.is_none()
+                && !(mixed && touches_another_material(nb, p, i));
+            (
+                fluid_support,
+                sph::viscous_acceleration(nb, p, None, face, i),
+            )
         });
     }
 }
