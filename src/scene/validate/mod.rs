@@ -748,8 +748,10 @@ impl Validator<'_> {
                 ),
             )?;
             let lattice = lattice_points_in(&bounds, container, s.spacing);
+            // The body's particles at t = 0: its lattice points, found once for every check.
+            let particles: Vec<&Vec<f64>> = lattice.iter().filter(|x| shape.contains(x)).collect();
             self.check(
-                lattice.iter().any(|x| shape.contains(x)),
+                !particles.is_empty(),
                 &format!("{key}.shape"),
                 format!(
                     "the {} holds no lattice point of the spacing {:?} m: make it larger than a spacing",
@@ -772,20 +774,19 @@ impl Validator<'_> {
                 }
             }
             if let Some(o) = obstacles.iter().position(|o| {
-                lattice
+                particles
                     .iter()
-                    .any(|x| shape.contains(x) && o.contains_within(x, 0.5 * s.spacing))
+                    .any(|x| o.contains_within(x, 0.5 * s.spacing))
             }) {
                 return Err(self.error(
                     &format!("{key}.shape"),
                     format!("the {} overlaps obstacle[{o}] at t = 0: bodies start clear of the obstacles", shape.name(dims)),
                 ));
             }
-            if let Some(o) = bodies.iter().position(|o| {
-                lattice
-                    .iter()
-                    .any(|x| shape.contains(x) && o.shape.contains(x))
-            }) {
+            if let Some(o) = bodies
+                .iter()
+                .position(|o| particles.iter().any(|x| o.shape.contains(x)))
+            {
                 return Err(self.error(
                     &format!("{key}.shape"),
                     format!(
@@ -819,8 +820,6 @@ impl Validator<'_> {
             };
             let motion = self.body_motion(b, &key, dims, &shape, s)?;
             if let BodyMotion::Prescribed(trajectory) = &motion {
-                let particles: Vec<&Vec<f64>> =
-                    lattice.iter().filter(|x| shape.contains(x)).collect();
                 let until = b.release.map_or(s.end_time, |r| r.min(s.end_time));
                 self.prescribed_path_clear(
                     trajectory, &particles, &key, &shape, container, obstacles, s.spacing, until,
