@@ -1,12 +1,16 @@
 //! Initial particles on a lattice of spacing dx anchored at the container's lower corner:
 //! fluid blocks, the container's dummy wall layers, solid obstacles and rigid bodies. The fluid particles
-//! are moved off their lattice points by a small deterministic perturbation
-//! (`simulation.perturbation`, `perturbed`).
+//! are moved off their lattice points by a small deterministic perturbation, except near a free
+//! surface (`perturbation`).
+
+mod perturbation;
 
 use crate::boundary::faces::Faces;
 use crate::math::lattice::for_each_lattice_point;
 use crate::particles::{Kind, NewParticle, Particles, NO_FLUID};
 use crate::scene::{Block, BodyMass, Scene};
+pub use perturbation::lattice_reach;
+use perturbation::{perturbed, NearOpenSpace};
 
 /// Particles of the scene at t = 0: fluid first (in block order), then walls, then each body's
 /// particles (in the order of the scene's bodies, so that a body's ids are contiguous). No
@@ -20,13 +24,19 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let in_obstacle = |x: &[f64; D]| in_obstacle(scene, x);
     let kept_clear = |x: &[f64; D]| near_obstacle(scene, x) || in_a_body(scene, x);
 
+    let amplitude = scene.perturbation * dx;
+    let on_lattice = (amplitude > 0.0).then(|| NearOpenSpace::new(scene, lattice_reach(scene)));
     let mut particles = Particles::<D>::default();
     for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
         let x = point(k);
         if let (Some(b), false) = (block_of(scene, &x), kept_clear(&x)) {
             let fluid = &scene.fluids[b.fluid];
+            let pos = match &on_lattice {
+                Some(near) if !near.contains(k) => perturbed(x, k, amplitude),
+                _ => x,
+            };
             particles.push(NewParticle {
-                pos: perturbed(x, k, scene.perturbation * dx),
+                pos,
                 kind: Kind::Fluid,
                 normal: [0.0; D],
                 fluid: b.fluid as u16,
@@ -167,40 +177,6 @@ pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) 
         room += !(near_obstacle(scene, &x) || in_a_body(scene, &x)) as usize;
     });
     particles.fluid_count() == room
-}
-
-/// Lattice point x (of index k) moved by up to `amplitude` along each axis, by a hash of k:
-/// the same displacement whatever the order of filling or the thread count.
-///
-/// A fluid on a perfect lattice stays one under a smooth strain: the lattice stretches along
-/// the flow and shrinks across it, and the shifting, which moves particles down gradients of
-/// their concentration, sees none in a lattice stretched evenly. When the rows come closer than
-/// the kernel resolves, the lattice breaks up at once, and the burst of disorder feeds the flow
-/// energy: on a Taylor–Green vortex 5% of its kinetic energy and 12% of velocity error at a
-/// fifth of L/U, at every resolution. Perturbed, the particles never line up, and the
-/// shifting keeps them spread from the first step (docs/accuracy.md, "The start-up error of the
-/// Taylor–Green vortex").
-fn perturbed<const D: usize>(x: [f64; D], k: [i64; D], amplitude: f64) -> [f64; D] {
-    if amplitude == 0.0 {
-        return x;
-    }
-    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-    for &k in &k {
-        seed = splitmix64(seed ^ k as u64);
-    }
-    std::array::from_fn(|d| {
-        let bits = splitmix64(seed ^ d as u64) >> 11;
-        let unit = bits as f64 / (1u64 << 53) as f64;
-        x[d] + amplitude * (2.0 * unit - 1.0)
-    })
-}
-
-/// The SplitMix64 mixing function (Steele, Lea & Flood 2014): 64 well-mixed bits from any input.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 /// Lattice points per axis inside the container.

@@ -33,6 +33,9 @@ pub struct Plan {
     /// The kernel support radius, in spacings.
     pub support_in_dx: f64,
     pub wall_layers: usize,
+    /// `simulation.perturbation` [dx], and the lattice steps from open space within which the
+    /// fluid keeps its lattice (`fill::lattice_reach`).
+    pub perturbation: (f64, i64),
     pub effects: Effects,
     /// The container's prescribed motion, described (None: at rest).
     pub container_motion: Option<String>,
@@ -121,6 +124,7 @@ impl Plan {
             kernel: scene.solver.kernel,
             support_in_dx: scene.solver.support_in_dx(),
             wall_layers: scene.wall_layers(),
+            perturbation: (scene.perturbation, crate::fill::lattice_reach(scene)),
             effects: scene.effects,
             container_motion: scene.container_motion.as_ref().map(|t| t.describe()),
             surface: scene.surface,
@@ -205,6 +209,7 @@ impl fmt::Display for Plan {
             self.support_in_dx,
             self.wall_layers
         )?;
+        writeln!(f, "start: {}", start_line(self.perturbation))?;
         writeln!(f, "effects: {}", effects_line(&self.effects))?;
         if let Some(motion) = &self.container_motion {
             writeln!(f, "container moves, solved in its frame: {motion}")?;
@@ -270,4 +275,13 @@ impl fmt::Display for Plan {
             mib(self.bytes())
         )
     }
+}
+
+/// Where the fluid particles start: on the lattice, or off it by up to `amplitude` spacings
+/// but within `reach` lattice steps of open space.
+fn start_line((amplitude, reach): (f64, i64)) -> String {
+    if amplitude == 0.0 {
+        return "fluid on the lattice (simulation.perturbation = 0)".into();
+    }
+    format!("fluid off its lattice points by up to {amplitude} dx per axis (simulation.perturbation), on them within {reach} spacings of open space (a flat free surface)")
 }
