@@ -104,6 +104,54 @@ fn bicgstab_matches_a_dense_solve_of_a_nonsymmetric_system() {
     assert!(info.iterations <= 1, "{info:?}");
 }
 
+/// Two systems solved in lockstep (`BiCgStab::solve_two`) end with the bits, iterations and
+/// residuals of the two solved one after the other, whichever finishes first: here a tight
+/// solve from zero beside a loose one from a warm start, and a solve beside one whose
+/// right-hand side is zero (done before its first apply).
+#[test]
+fn lockstep_solves_have_the_bits_of_solves_in_turn() {
+    let a = ConvectionDiffusion { n: 300, c: 0.4 };
+    let b: Vec<f64> = (0..a.n)
+        .map(|i| ((i * 37 % 11) as f64 - 5.0) / 5.0)
+        .collect();
+    let b2: Vec<f64> = (0..a.n).map(|i| (0.05 * i as f64).sin()).collect();
+    let tight = SolverParams {
+        tolerance: 1e-10,
+        max_iterations: 2000,
+    };
+    let loose = SolverParams {
+        tolerance: 1e-2,
+        ..tight
+    };
+    let warm: Vec<f64> = (0..a.n).map(|i| 0.1 * (i % 5) as f64).collect();
+    let zero = vec![0.0; a.n];
+    let mut jacobi = Jacobi::default();
+    jacobi.setup(&a).unwrap();
+    for (b2, params2) in [(&b2, loose), (&zero, tight)] {
+        let (mut x, mut x2) = (vec![0.0; a.n], warm.clone());
+        let info = BiCgStab::default()
+            .solve(&a, &mut jacobi, &b, &mut x, tight)
+            .unwrap();
+        let info2 = BiCgStab::default()
+            .solve(&a, &mut jacobi, b2, &mut x2, params2)
+            .unwrap();
+        let (mut y, mut y2) = (vec![0.0; a.n], warm.clone());
+        let (both, both2) = BiCgStab::default()
+            .solve_two(
+                &mut BiCgStab::default(),
+                &a,
+                &mut jacobi,
+                (&b, &mut y, tight),
+                (b2, &mut y2, params2),
+            )
+            .unwrap();
+        assert_eq!((both, both2), (info, info2));
+        assert!(info.iterations > info2.iterations, "{info:?} {info2:?}");
+        assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(x2.iter().zip(&y2).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+}
+
 /// Rows with the structure of the PPE's (`ppe::PressureOperator`) over a row of `CELLS` cells,
 /// two unknowns per cell, unknown i coupled to i ± 1 with weight 1, a_ii = Σ w (plus 1 at the
 /// two ends, a fixed value outside): except in every seventh cell, whose unknowns couple to

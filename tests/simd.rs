@@ -117,6 +117,19 @@ fn check<const D: usize>(n: i64) {
     let x: Vec<f64> = (0..nf).map(|i| phi(i) * phi(i)).collect();
     let mut ax = vec![0.0; nf];
     op.apply(&x, &mut ax);
+    // Two applies in one walk (the lockstep solves) have the bits of two walks.
+    let x2: Vec<f64> = (0..nf).map(phi).collect();
+    let (mut ax2, mut both, mut both2) = (vec![0.0; nf], vec![0.0; nf], vec![0.0; nf]);
+    op.apply(&x2, &mut ax2);
+    op.apply_two(&x, &mut both, &x2, &mut both2);
+    assert!(both
+        .iter()
+        .zip(&ax)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
+    assert!(both2
+        .iter()
+        .zip(&ax2)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
     // The multigrid takes the fine diagonal from the coarse-row pass: it must have the bits of
     // the operator's own diagonal (the weights summed in the same order).
     let mut diagonal = vec![0.0; nf];

@@ -73,6 +73,18 @@ pub fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync) {
         });
 }
 
+/// (a[i], b[i]) = f(i) for every i: two results of one pass.
+pub fn fill_pair<T: Send>(a: &mut [T], b: &mut [T], f: impl Fn(usize) -> [T; 2] + Sync) {
+    a.par_chunks_mut(BLOCK)
+        .zip(b.par_chunks_mut(BLOCK))
+        .enumerate()
+        .for_each(|(c, (a, b))| {
+            for (k, (a, b)) in a.iter_mut().zip(b).enumerate() {
+                [*a, *b] = f(c * BLOCK + k);
+            }
+        });
+}
+
 /// out[d][i] = f(i)[d] for every i: a per-particle vector result written into SoA components.
 pub fn fill_vector<const D: usize>(out: &mut [Vec<f64>; D], f: impl Fn(usize) -> [f64; D] + Sync) {
     component_blocks(out)

@@ -11,6 +11,12 @@ use rayon::prelude::*;
 pub trait LinearOperator: Sync {
     fn len(&self) -> usize;
     fn apply(&self, x: &[f64], y: &mut [f64]);
+    /// y = A x and y₂ = A x₂, the same bits as two applies (an operator that walks its rows
+    /// applies both in one walk).
+    fn apply_two(&self, x: &[f64], y: &mut [f64], x2: &[f64], y2: &mut [f64]) {
+        self.apply(x, y);
+        self.apply(x2, y2);
+    }
     /// The diagonal of A (for the Jacobi preconditioner).
     fn diagonal(&self, diag: &mut [f64]);
 }
@@ -139,89 +145,241 @@ impl BiCgStab {
         x: &mut [f64],
         params: SolverParams,
     ) -> Result<SolveInfo, SolverError> {
-        let n = a.len();
-        self.resize(n);
+        let mut run = Run::new(self, a.len(), b, x, params);
+        loop {
+            match run.prepare(a, m) {
+                Some((input, output)) => a.apply(input, output),
+                None => return run.outcome(),
+            }
+            run.absorb();
+        }
+    }
 
+    /// Solves A x = b with `self`'s vectors and A x₂ = b₂ with `other`'s, in lockstep: while
+    /// both run, each apply of A is one `LinearOperator::apply_two` for both systems (one walk
+    /// of a matrix-free operator's rows instead of two). Each system's arithmetic is that of
+    /// `solve`: the same iterates and bits as two solves one after the other.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_two<A: LinearOperator>(
+        &mut self,
+        other: &mut BiCgStab,
+        a: &A,
+        m: &mut impl Preconditioner<A>,
+        (b, x, params): (&[f64], &mut [f64], SolverParams),
+        (b2, x2, params2): (&[f64], &mut [f64], SolverParams),
+    ) -> Result<(SolveInfo, SolveInfo), SolverError> {
+        let n = a.len();
+        let (mut first, mut second) = (
+            Run::new(self, n, b, x, params),
+            Run::new(other, n, b2, x2, params2),
+        );
+        loop {
+            match (first.prepare(a, m), second.prepare(a, m)) {
+                (Some((x, y)), Some((x2, y2))) => a.apply_two(x, y, x2, y2),
+                (Some((x, y)), None) | (None, Some((x, y))) => a.apply(x, y),
+                (None, None) => return Ok((first.outcome()?, second.outcome()?)),
+            }
+            first.absorb();
+            second.absorb();
+        }
+    }
+}
+
+/// Where a BiCGSTAB run stands: each state but `Done` waits for one apply of A.
+#[derive(Clone, Copy, PartialEq)]
+enum Stage {
+    /// r = A x₀, for r = b − A x₀.
+    Start,
+    /// v = A p̂, p̂ the preconditioned search direction.
+    Search,
+    /// t = A ŝ, ŝ the preconditioned intermediate residual.
+    Stabilise,
+    /// t = A x, for the true residual reported.
+    Finish,
+    Done,
+}
+
+/// One BiCGSTAB solve (van der Vorst 1992, right preconditioning) cut at its applies of A, so
+/// that two solves can share them (`BiCgStab::solve_two`). `prepare` does the work before the
+/// next apply and names its input and output; `absorb` the work after it.
+struct Run<'a> {
+    work: &'a mut BiCgStab,
+    b: &'a [f64],
+    x: &'a mut [f64],
+    params: SolverParams,
+    b_norm: f64,
+    tol: f64,
+    stage: Stage,
+    iterations: usize,
+    converged: bool,
+    rho: f64,
+    rho_old: f64,
+    alpha: f64,
+    omega: f64,
+    outcome: Option<Result<SolveInfo, SolverError>>,
+}
+
+impl<'a> Run<'a> {
+    fn new(
+        work: &'a mut BiCgStab,
+        n: usize,
+        b: &'a [f64],
+        x: &'a mut [f64],
+        params: SolverParams,
+    ) -> Self {
+        work.resize(n);
         let b_norm = norm(b);
+        let mut run = Self {
+            work,
+            b,
+            x,
+            params,
+            b_norm,
+            tol: params.tolerance * b_norm,
+            stage: Stage::Start,
+            iterations: 0,
+            converged: false,
+            rho: 1.0,
+            rho_old: 1.0,
+            alpha: 1.0,
+            omega: 1.0,
+            outcome: None,
+        };
         if b_norm == 0.0 {
-            x.fill(0.0);
-            return Ok(SolveInfo {
+            run.x.fill(0.0);
+            run.finish(Ok(SolveInfo {
                 iterations: 0,
                 relative_residual: 0.0,
                 converged: true,
-            });
+            }));
         }
-        let tol = params.tolerance * b_norm;
-        let Self {
-            r,
-            r_hat,
-            p,
-            v,
-            s,
-            t,
-            p_hat,
-            s_hat,
-        } = self;
+        run
+    }
 
-        a.apply(x, r);
-        r.par_iter_mut().zip(b).for_each(|(r, b)| *r = b - *r);
-        r_hat.copy_from_slice(r);
-        p.fill(0.0);
-        v.fill(0.0);
-        let (mut rho_old, mut alpha, mut omega) = (1.0, 1.0, 1.0);
-        let mut iterations = 0;
-        let mut converged = norm(r) <= tol;
-        while !converged && iterations < params.max_iterations {
-            iterations += 1;
-            let mut rho = dot(r_hat, r);
-            if rho.abs() < 1e-300 {
-                // Breakdown of the shadow residual: restart from the current residual.
-                r_hat.copy_from_slice(r);
-                p.fill(0.0);
-                v.fill(0.0);
-                (rho_old, alpha, omega) = (1.0, 1.0, 1.0);
-                rho = dot(r_hat, r);
+    fn finish(&mut self, outcome: Result<SolveInfo, SolverError>) {
+        self.stage = Stage::Done;
+        self.outcome = Some(outcome);
+    }
+
+    fn outcome(&mut self) -> Result<SolveInfo, SolverError> {
+        self.outcome
+            .take()
+            .expect("a run is done before its outcome")
+    }
+
+    /// The work before the next apply of A, and that apply's input and output (None: done).
+    fn prepare<A: LinearOperator>(
+        &mut self,
+        a: &A,
+        m: &mut impl Preconditioner<A>,
+    ) -> Option<(&[f64], &mut [f64])> {
+        let w = &mut *self.work;
+        match self.stage {
+            Stage::Start => Some((&*self.x, &mut w.r)),
+            Stage::Search => {
+                self.iterations += 1;
+                let mut rho = dot(&w.r_hat, &w.r);
+                if rho.abs() < 1e-300 {
+                    // Breakdown of the shadow residual: restart from the current residual.
+                    w.r_hat.copy_from_slice(&w.r);
+                    w.p.fill(0.0);
+                    w.v.fill(0.0);
+                    (self.rho_old, self.alpha, self.omega) = (1.0, 1.0, 1.0);
+                    rho = dot(&w.r_hat, &w.r);
+                }
+                self.rho = rho;
+                let beta = (rho / self.rho_old) * (self.alpha / self.omega);
+                let (r, v, omega) = (&w.r, &w.v, self.omega);
+                w.p.par_iter_mut()
+                    .enumerate()
+                    .for_each(|(i, p)| *p = r[i] + beta * (*p - omega * v[i]));
+                m.precondition(a, &w.p, &mut w.p_hat);
+                Some((&w.p_hat, &mut w.v))
             }
-            let beta = (rho / rho_old) * (alpha / omega);
-            p.par_iter_mut()
-                .enumerate()
-                .for_each(|(i, p)| *p = r[i] + beta * (*p - omega * v[i]));
-            m.precondition(a, p, p_hat);
-            a.apply(p_hat, v);
-            alpha = rho / dot(r_hat, v);
-            fill(s, |i| r[i] - alpha * v[i]);
-            if norm(s) <= tol {
-                x.par_iter_mut()
-                    .zip(p_hat.par_iter())
-                    .for_each(|(x, ph)| *x += alpha * ph);
-                converged = true;
-                break;
+            Stage::Stabilise => {
+                m.precondition(a, &w.s, &mut w.s_hat);
+                Some((&w.s_hat, &mut w.t))
             }
-            m.precondition(a, s, s_hat);
-            a.apply(s_hat, t);
-            omega = dot(t, s) / dot(t, t);
-            x.par_iter_mut()
-                .enumerate()
-                .for_each(|(i, x)| *x += alpha * p_hat[i] + omega * s_hat[i]);
-            fill(r, |i| s[i] - omega * t[i]);
-            let r_norm = norm(r);
-            if !r_norm.is_finite() {
-                return Err(SolverError::NotFinite { iterations });
-            }
-            converged = r_norm <= tol;
-            rho_old = rho;
+            Stage::Finish => Some((&*self.x, &mut w.t)),
+            Stage::Done => None,
         }
-        // Report the true residual, not the recursively updated one.
-        a.apply(x, t);
-        t.par_iter_mut().zip(b).for_each(|(t, b)| *t = b - *t);
-        let relative_residual = norm(t) / b_norm;
-        if !relative_residual.is_finite() {
-            return Err(SolverError::NotFinite { iterations });
+    }
+
+    /// The work after the apply `prepare` asked for (a non-finite residual ends the run with
+    /// an error).
+    fn absorb(&mut self) {
+        let w = &mut *self.work;
+        match self.stage {
+            Stage::Start => {
+                let b = self.b;
+                w.r.par_iter_mut().zip(b).for_each(|(r, b)| *r = b - *r);
+                w.r_hat.copy_from_slice(&w.r);
+                w.p.fill(0.0);
+                w.v.fill(0.0);
+                self.converged = norm(&w.r) <= self.tol;
+                self.stage = self.next_iteration();
+            }
+            Stage::Search => {
+                self.alpha = self.rho / dot(&w.r_hat, &w.v);
+                let (r, v, alpha) = (&w.r, &w.v, self.alpha);
+                fill(&mut w.s, |i| r[i] - alpha * v[i]);
+                if norm(&w.s) <= self.tol {
+                    self.x
+                        .par_iter_mut()
+                        .zip(w.p_hat.par_iter())
+                        .for_each(|(x, ph)| *x += alpha * ph);
+                    self.converged = true;
+                    self.stage = Stage::Finish;
+                } else {
+                    self.stage = Stage::Stabilise;
+                }
+            }
+            Stage::Stabilise => {
+                let (t, s) = (&w.t, &w.s);
+                self.omega = dot(t, s) / dot(t, t);
+                let (alpha, omega, p_hat, s_hat) = (self.alpha, self.omega, &w.p_hat, &w.s_hat);
+                self.x
+                    .par_iter_mut()
+                    .enumerate()
+                    .for_each(|(i, x)| *x += alpha * p_hat[i] + omega * s_hat[i]);
+                fill(&mut w.r, |i| s[i] - omega * t[i]);
+                let r_norm = norm(&w.r);
+                if !r_norm.is_finite() {
+                    let iterations = self.iterations;
+                    self.finish(Err(SolverError::NotFinite { iterations }));
+                    return;
+                }
+                self.converged = r_norm <= self.tol;
+                self.rho_old = self.rho;
+                self.stage = self.next_iteration();
+            }
+            Stage::Finish => {
+                // Report the true residual, not the recursively updated one.
+                let b = self.b;
+                w.t.par_iter_mut().zip(b).for_each(|(t, b)| *t = b - *t);
+                let relative_residual = norm(&w.t) / self.b_norm;
+                let iterations = self.iterations;
+                let outcome = if relative_residual.is_finite() {
+                    Ok(SolveInfo {
+                        iterations,
+                        relative_residual,
+                        converged: self.converged,
+                    })
+                } else {
+                    Err(SolverError::NotFinite { iterations })
+                };
+                self.finish(outcome);
+            }
+            Stage::Done => {}
         }
-        Ok(SolveInfo {
-            iterations,
-            relative_residual,
-            converged,
-        })
+    }
+
+    /// Another iteration, or the true residual once converged or out of iterations.
+    fn next_iteration(&self) -> Stage {
+        if self.converged || self.iterations >= self.params.max_iterations {
+            Stage::Finish
+        } else {
+            Stage::Search
+        }
     }
 }

@@ -18,7 +18,7 @@
 
 use crate::boundary::ghosts::{behind_walls, ghost_pressure_difference, ghost_velocity, BodyForce};
 use crate::math::lanes::{F64s, Sum, LANES};
-use crate::math::reduce::{fill, fill_vector};
+use crate::math::reduce::{fill, fill_pair, fill_vector};
 use crate::neighbours::Lanes;
 use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
@@ -505,20 +505,25 @@ impl<const D: usize> PressureOperator<'_, D> {
         b.total()
     }
 
-    /// (A x)_i: the interior rows couple fluid neighbours only (the walls' pairs are known
-    /// numbers, in the right-hand side).
-    #[inline]
-    fn row(&self, x: &[f64], i: usize) -> f64 {
+    /// (A x)_i for each of the K vectors x, in one walk of row i's neighbours: the interior
+    /// rows couple fluid neighbours only (the walls' pairs are known numbers, in the
+    /// right-hand side). Each vector's sum is the one a walk for it alone makes.
+    #[inline(always)]
+    fn rows<const K: usize>(&self, x: [&[f64]; K], i: usize) -> [f64; K] {
         match self.roles[i] {
             Role::Interior => {
-                let (xi, row) = (F64s::splat(x[i]), self.row_constants(i));
-                let mut ax = Sum::ZERO;
+                let row = self.row_constants(i);
+                let xi = x.map(|x| F64s::splat(x[i]));
+                let mut ax = [Sum::ZERO; K];
                 self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-                    ax = ax.mul_add(self.fluid_weights(&row, l), xi - l.load(x));
+                    let w = self.fluid_weights(&row, l);
+                    for k in 0..K {
+                        ax[k] = ax[k].mul_add(w, xi[k] - l.load(x[k]));
+                    }
                 });
-                ax.total()
+                ax.map(|a| a.total())
             }
-            Role::Surface | Role::Splash | Role::Reference => x[i],
+            Role::Surface | Role::Splash | Role::Reference => x.map(|x| x[i]),
         }
     }
 }
@@ -529,7 +534,13 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
     }
 
     fn apply(&self, x: &[f64], y: &mut [f64]) {
-        fill(y, |i| self.row(x, i));
+        fill(y, |i| self.rows([x], i)[0]);
+    }
+
+    /// Both applies in one walk: the walk and the weights, two thirds of an apply's time
+    /// (docs/performance.md, "The PPE apply"), are shared.
+    fn apply_two(&self, x: &[f64], y: &mut [f64], x2: &[f64], y2: &mut [f64]) {
+        fill_pair(y, y2, |i| self.rows([x, x2], i));
     }
 
     fn diagonal(&self, diag: &mut [f64]) {
