@@ -10,6 +10,7 @@
 //! form one block at least one support wide: the aggregates of the PPE's multigrid
 //! (`blocks`), whose stencil then reaches the adjacent blocks only.
 
+use crate::math::lanes::F64s;
 use crate::math::memory::ArraySize;
 use crate::particles::Kind;
 use rayon::prelude::*;
@@ -173,6 +174,14 @@ impl<const D: usize> CellList<D> {
     #[inline]
     pub fn block_along(&self, d: usize, x: f64) -> i64 {
         self.cell_along(d, x) / subdivision(d) as i64
+    }
+
+    /// `block_along` of the coordinates `x` of a chunk's lanes, as whole numbers.
+    #[inline(always)]
+    pub fn block_along_lanes(&self, d: usize, x: F64s) -> F64s {
+        let cell = ((x - F64s::splat(self.origin[d])) * F64s::splat(self.inv_width[d])).floor();
+        let cell = cell.fast_min(F64s::splat((self.dims[d] - 1) as f64));
+        (cell * F64s::splat(1.0 / subdivision(d) as f64)).floor()
     }
 
     /// The per-particle array of the grid: the cell of each particle in the sorted order.

@@ -573,27 +573,33 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
         // Interior rows: a_ii = Σ w, a_ij = −w; the other rows are not aggregated.
         debug_assert_eq!(self.roles[i], Role::Interior, "row {i} is not aggregated");
         let (grid, p) = (self.nb.grid(), self.p);
-        let block =
-            |j: usize| -> [i64; D] { std::array::from_fn(|d| grid.block_along(d, p.pos[d][j])) };
-        let (centre, block_i) = (stencil_slot([0; D]), block(i));
+        let block_i: [F64s; D] =
+            std::array::from_fn(|d| F64s::splat(grid.block_along(d, p.pos[d][i]) as f64));
+        let (centre, one, three) = (stencil_slot([0; D]), F64s::ONE, F64s::splat(3.0));
         let constants = self.row_constants(i);
         let mut diagonal = Sum::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
             let w = self.fluid_weights(&constants, l);
             diagonal += w;
-            for (k, w) in w.to_array().into_iter().enumerate() {
+            // Each lane's block offset from row i's, its slot in the 3^D stencil (x fastest)
+            // and whether it lies within it, computed in lanes from the absolute positions.
+            let (mut slot, mut within) = (F64s::ZERO, u32::MAX);
+            for d in (0..D).rev() {
+                let offset = grid.block_along_lanes(d, l.load(&p.pos[d])) - block_i[d];
+                within &= offset.abs().simd_le(one).to_bitmask();
+                slot = slot.mul_add(three, offset + one);
+            }
+            let (w, slot) = (w.to_array(), slot.to_array());
+            for (k, w) in w.into_iter().enumerate() {
                 if w == 0.0 {
                     continue;
                 }
                 row[centre] += w;
-                let j = l.j0 + k;
                 // A coupling across a periodic boundary joins blocks at the two ends of the
                 // grid, outside the 3^D stencil: the coarse levels leave it out (their row keeps
                 // its diagonal), which only weakens the preconditioner near that boundary.
-                let block_j = block(j);
-                let offset: [i64; D] = std::array::from_fn(|d| block_j[d] - block_i[d]);
-                if self.roles[j] == Role::Interior && offset.iter().all(|o| o.abs() <= 1) {
-                    row[stencil_slot(offset)] -= w;
+                if within >> k & 1 == 1 && self.roles[l.j0 + k] == Role::Interior {
+                    row[slot[k] as usize] -= w;
                 }
             }
         });
