@@ -39,6 +39,7 @@ fn still_water_started_off_its_lattice_keeps_a_flat_surface() {
     let dir = TempDir::new("perturbed_still_water");
     run_scene(&scene, dir.path(), 2.0);
     let (dx, depth) = (scene.spacing, 0.5);
+    let reach = isph::fill::lattice_reach(&scene) as f64;
     let kind: Vec<i32> = read_frame(dir.path(), 0, "kind");
     let pos: Vec<f64> = read_frame(dir.path(), 0, "position");
     let off_lattice = |i: usize| {
@@ -49,7 +50,7 @@ fn still_water_started_off_its_lattice_keeps_a_flat_surface() {
     };
     let fluid = (0..kind.len()).filter(|&i| kind[i] == 0);
     let (near_surface, deeper): (Vec<usize>, Vec<usize>) =
-        fluid.partition(|&i| pos[3 * i + 1] > depth - 4.0 * dx);
+        fluid.partition(|&i| pos[3 * i + 1] > depth - reach * dx);
     assert!(near_surface.iter().all(|&i| !off_lattice(i)));
     assert!(deeper.iter().filter(|&&i| off_lattice(i)).count() > deeper.len() / 2);
     let fastest = stats_column(dir.path(), "max_speed")

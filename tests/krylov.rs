@@ -105,7 +105,7 @@ fn bicgstab_matches_a_dense_solve_of_a_nonsymmetric_system() {
 }
 
 /// Two systems solved in lockstep (`BiCgStab::solve_two`) end with the bits, iterations and
-/// residuals of the two solved one after the other, whichever finishes first: here a tight
+/// residuals of the two solved one after the other, whichever is given first: here a tight
 /// solve from zero beside a loose one from a warm start, and a solve beside one whose
 /// right-hand side is zero (done before its first apply).
 #[test]
@@ -149,6 +149,20 @@ fn lockstep_solves_have_the_bits_of_solves_in_turn() {
         assert!(info.iterations > info2.iterations, "{info:?} {info2:?}");
         assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()));
         assert!(x2.iter().zip(&y2).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // The same two, the one that finishes first given first.
+        let (mut z2, mut z) = (warm.clone(), vec![0.0; a.n]);
+        let swapped = BiCgStab::default()
+            .solve_two(
+                &mut BiCgStab::default(),
+                &a,
+                &mut jacobi,
+                (b2, &mut z2, params2),
+                (&b, &mut z, tight),
+            )
+            .unwrap();
+        assert_eq!(swapped, (info2, info));
+        assert!(x.iter().zip(&z).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(x2.iter().zip(&z2).all(|(a, b)| a.to_bits() == b.to_bits()));
     }
 }
 

@@ -13,8 +13,8 @@
 //!
 //! Why not at the free surface: the free-surface particles carry the surface's Dirichlet
 //! pressure where they are, so a perturbed top row is a rough surface, and its grid-scale
-//! bumps of height a are gravity waves of speed √(g k) a, k = π/dx: 0.06 m/s for a = 0.1 dx at
-//! dx = 12.5 mm. The rows within a support below it move the surface particles through their
+//! bumps of height a are gravity waves whose water moves at √(g k) a, k = π/dx: 0.06 m/s for
+//! a = 0.1 dx at dx = 12.5 mm. The rows within a support below it move the surface particles through their
 //! pressure. Kept on the lattice, the surface starts flat and the still water of
 //! `scenes/hydrostatic_2d.toml` moves a hundred times slower (docs/accuracy.md).
 
@@ -91,9 +91,6 @@ impl<const D: usize> NearOpenSpace<D> {
 /// Lattice point x (of index k) moved by up to `amplitude` along each axis, by a hash of k:
 /// the same displacement whatever the order of filling or the thread count.
 pub fn perturbed<const D: usize>(x: [f64; D], k: [i64; D], amplitude: f64) -> [f64; D] {
-    if amplitude == 0.0 {
-        return x;
-    }
     let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
     for &k in &k {
         seed = splitmix64(seed ^ k as u64);

@@ -75,6 +75,7 @@ pub fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync) {
 
 /// (a[i], b[i]) = f(i) for every i: two results of one pass.
 pub fn fill_pair<T: Send>(a: &mut [T], b: &mut [T], f: impl Fn(usize) -> [T; 2] + Sync) {
+    debug_assert_eq!(a.len(), b.len(), "two results of one pass have one length");
     a.par_chunks_mut(BLOCK)
         .zip(b.par_chunks_mut(BLOCK))
         .enumerate()

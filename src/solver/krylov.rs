@@ -21,7 +21,8 @@ pub trait LinearOperator: Sync {
     fn diagonal(&self, diag: &mut [f64]);
 }
 
-/// z ≈ A⁻¹ r: a fixed linear map built once per solve from the operator.
+/// z ≈ A⁻¹ r: a fixed linear map built once per solve from the operator; z depends on r alone,
+/// never on earlier calls (`BiCgStab::solve_two` interleaves two solves' calls).
 pub trait Preconditioner<A: LinearOperator> {
     fn setup(&mut self, a: &A) -> Result<(), SolverError>;
     fn precondition(&mut self, a: &A, r: &[f64], z: &mut [f64]);
@@ -158,8 +159,9 @@ impl BiCgStab {
     /// Solves A x = b with `self`'s vectors and A x₂ = b₂ with `other`'s, in lockstep: while
     /// both run, each apply of A is one `LinearOperator::apply_two` for both systems (one walk
     /// of a matrix-free operator's rows instead of two). Each system's arithmetic is that of
-    /// `solve`: the same iterates and bits as two solves one after the other.
-    #[allow(clippy::too_many_arguments)]
+    /// `solve`: the same iterates and bits as two solves one after the other, as `m`'s
+    /// `precondition` depends on its input alone, never on its earlier calls. The first error
+    /// of either system ends both.
     pub fn solve_two<A: LinearOperator>(
         &mut self,
         other: &mut BiCgStab,
@@ -181,13 +183,18 @@ impl BiCgStab {
             }
             first.absorb();
             second.absorb();
+            for run in [&mut first, &mut second] {
+                if let Some(Err(_)) = run.outcome {
+                    return Err(run.outcome().expect_err("the run failed"));
+                }
+            }
         }
     }
 }
 
-/// Where a BiCGSTAB run stands: each state but `Done` waits for one apply of A.
-#[derive(Clone, Copy, PartialEq)]
-enum Stage {
+/// Where a BiCGSTAB run stands: each phase but `Done` waits for one apply of A.
+#[derive(Clone, Copy)]
+enum Phase {
     /// r = A x₀, for r = b − A x₀.
     Start,
     /// v = A p̂, p̂ the preconditioned search direction.
@@ -209,7 +216,7 @@ struct Run<'a> {
     params: SolverParams,
     b_norm: f64,
     tol: f64,
-    stage: Stage,
+    phase: Phase,
     iterations: usize,
     converged: bool,
     rho: f64,
@@ -236,7 +243,7 @@ impl<'a> Run<'a> {
             params,
             b_norm,
             tol: params.tolerance * b_norm,
-            stage: Stage::Start,
+            phase: Phase::Start,
             iterations: 0,
             converged: false,
             rho: 1.0,
@@ -257,7 +264,7 @@ impl<'a> Run<'a> {
     }
 
     fn finish(&mut self, outcome: Result<SolveInfo, SolverError>) {
-        self.stage = Stage::Done;
+        self.phase = Phase::Done;
         self.outcome = Some(outcome);
     }
 
@@ -274,9 +281,9 @@ impl<'a> Run<'a> {
         m: &mut impl Preconditioner<A>,
     ) -> Option<(&[f64], &mut [f64])> {
         let w = &mut *self.work;
-        match self.stage {
-            Stage::Start => Some((&*self.x, &mut w.r)),
-            Stage::Search => {
+        match self.phase {
+            Phase::Start => Some((&*self.x, &mut w.r)),
+            Phase::Search => {
                 self.iterations += 1;
                 let mut rho = dot(&w.r_hat, &w.r);
                 if rho.abs() < 1e-300 {
@@ -296,12 +303,12 @@ impl<'a> Run<'a> {
                 m.precondition(a, &w.p, &mut w.p_hat);
                 Some((&w.p_hat, &mut w.v))
             }
-            Stage::Stabilise => {
+            Phase::Stabilise => {
                 m.precondition(a, &w.s, &mut w.s_hat);
                 Some((&w.s_hat, &mut w.t))
             }
-            Stage::Finish => Some((&*self.x, &mut w.t)),
-            Stage::Done => None,
+            Phase::Finish => Some((&*self.x, &mut w.t)),
+            Phase::Done => None,
         }
     }
 
@@ -309,17 +316,17 @@ impl<'a> Run<'a> {
     /// an error).
     fn absorb(&mut self) {
         let w = &mut *self.work;
-        match self.stage {
-            Stage::Start => {
+        match self.phase {
+            Phase::Start => {
                 let b = self.b;
                 w.r.par_iter_mut().zip(b).for_each(|(r, b)| *r = b - *r);
                 w.r_hat.copy_from_slice(&w.r);
                 w.p.fill(0.0);
                 w.v.fill(0.0);
                 self.converged = norm(&w.r) <= self.tol;
-                self.stage = self.next_iteration();
+                self.phase = self.next_iteration();
             }
-            Stage::Search => {
+            Phase::Search => {
                 self.alpha = self.rho / dot(&w.r_hat, &w.v);
                 let (r, v, alpha) = (&w.r, &w.v, self.alpha);
                 fill(&mut w.s, |i| r[i] - alpha * v[i]);
@@ -329,12 +336,12 @@ impl<'a> Run<'a> {
                         .zip(w.p_hat.par_iter())
                         .for_each(|(x, ph)| *x += alpha * ph);
                     self.converged = true;
-                    self.stage = Stage::Finish;
+                    self.phase = Phase::Finish;
                 } else {
-                    self.stage = Stage::Stabilise;
+                    self.phase = Phase::Stabilise;
                 }
             }
-            Stage::Stabilise => {
+            Phase::Stabilise => {
                 let (t, s) = (&w.t, &w.s);
                 self.omega = dot(t, s) / dot(t, t);
                 let (alpha, omega, p_hat, s_hat) = (self.alpha, self.omega, &w.p_hat, &w.s_hat);
@@ -351,9 +358,9 @@ impl<'a> Run<'a> {
                 }
                 self.converged = r_norm <= self.tol;
                 self.rho_old = self.rho;
-                self.stage = self.next_iteration();
+                self.phase = self.next_iteration();
             }
-            Stage::Finish => {
+            Phase::Finish => {
                 // Report the true residual, not the recursively updated one.
                 let b = self.b;
                 w.t.par_iter_mut().zip(b).for_each(|(t, b)| *t = b - *t);
@@ -370,16 +377,16 @@ impl<'a> Run<'a> {
                 };
                 self.finish(outcome);
             }
-            Stage::Done => {}
+            Phase::Done => {}
         }
     }
 
     /// Another iteration, or the true residual once converged or out of iterations.
-    fn next_iteration(&self) -> Stage {
+    fn next_iteration(&self) -> Phase {
         if self.converged || self.iterations >= self.params.max_iterations {
-            Stage::Finish
+            Phase::Finish
         } else {
-            Stage::Search
+            Phase::Search
         }
     }
 }

@@ -537,8 +537,8 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
         fill(y, |i| self.rows([x], i)[0]);
     }
 
-    /// Both applies in one walk: the walk and the weights, two thirds of an apply's time
-    /// (docs/performance.md, "The PPE apply"), are shared.
+    /// Both applies in one walk: the walk (two thirds of an apply's time, docs/performance.md,
+    /// "The PPE apply") and the weights are shared.
     fn apply_two(&self, x: &[f64], y: &mut [f64], x2: &[f64], y2: &mut [f64]) {
         fill_pair(y, y2, |i| self.rows([x, x2], i));
     }
@@ -583,11 +583,13 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
             diagonal += w;
             // Each lane's block offset from row i's, its slot in the 3^D stencil (x fastest)
             // and whether it lies within it, computed in lanes from the absolute positions.
+            // `stencil_slot` in lanes.
+            let offset: [F64s; D] =
+                std::array::from_fn(|d| grid.block_along_lanes(d, l.load(&p.pos[d])) - block_i[d]);
             let (mut slot, mut within) = (F64s::ZERO, u32::MAX);
             for d in (0..D).rev() {
-                let offset = grid.block_along_lanes(d, l.load(&p.pos[d])) - block_i[d];
-                within &= offset.abs().simd_le(one).to_bitmask();
-                slot = slot.mul_add(three, offset + one);
+                within &= offset[d].abs().simd_le(one).to_bitmask();
+                slot = slot.mul_add(three, offset[d] + one);
             }
             let (w, slot) = (w.to_array(), slot.to_array());
             for (k, w) in w.into_iter().enumerate() {
@@ -599,6 +601,10 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
                 // grid, outside the 3^D stencil: the coarse levels leave it out (their row keeps
                 // its diagonal), which only weakens the preconditioner near that boundary.
                 if within >> k & 1 == 1 && self.roles[l.j0 + k] == Role::Interior {
+                    debug_assert_eq!(
+                        slot[k] as usize,
+                        stencil_slot::<D>(std::array::from_fn(|d| offset[d].to_array()[k] as i64))
+                    );
                     row[slot[k] as usize] -= w;
                 }
             }

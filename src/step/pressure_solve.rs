@@ -52,6 +52,34 @@ struct DensitySolve {
     bicgstab: BiCgStab,
 }
 
+impl DensitySolve {
+    /// Solves for P_α from zero, to `DENSITY_TOLERANCE`, in lockstep with the `projection`
+    /// (right-hand side, warm-started solution, parameters) on the projection's `bicgstab`
+    /// vectors; reports both solves together: their iterations summed, the larger residual.
+    fn solve_beside<const D: usize>(
+        &mut self,
+        bicgstab: &mut BiCgStab,
+        op: &PressureOperator<D>,
+        mg: &mut Multigrid<D>,
+        projection: (&[f64], &mut [f64], SolverParams),
+    ) -> Result<SolveInfo, SolverError> {
+        self.pressure.clear();
+        self.pressure.resize(op.roles.len(), 0.0);
+        let params = SolverParams {
+            tolerance: projection.2.tolerance.max(DENSITY_TOLERANCE),
+            ..projection.2
+        };
+        let correction = (&self.rhs[..], &mut self.pressure[..], params);
+        let (info, density) =
+            bicgstab.solve_two(&mut self.bicgstab, op, mg, projection, correction)?;
+        Ok(SolveInfo {
+            iterations: info.iterations + density.iterations,
+            relative_residual: info.relative_residual.max(density.relative_residual),
+            converged: info.converged && density.converged,
+        })
+    }
+}
+
 /// The per-row arrays of the operator.
 struct Rows<const D: usize> {
     /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
@@ -145,22 +173,7 @@ impl<const D: usize> PressureSolve<D> {
                         let rate = set.alpha / step.limit;
                         let full = s.full_support;
                         ppe::density_source(op, closed, sealed, full, step.dt, rate, &mut d.rhs);
-                        d.pressure.clear();
-                        d.pressure.resize(nf, 0.0);
-                        let params = SolverParams {
-                            tolerance: set.solver.tolerance.max(DENSITY_TOLERANCE),
-                            ..set.solver
-                        };
-                        let correction = (&d.rhs[..], &mut d.pressure[..], params);
-                        let (info, density) =
-                            bicgstab.solve_two(&mut d.bicgstab, op, mg, projection, correction)?;
-                        SolveInfo {
-                            iterations: info.iterations + density.iterations,
-                            relative_residual: info
-                                .relative_residual
-                                .max(density.relative_residual),
-                            converged: info.converged && density.converged,
-                        }
+                        d.solve_beside(bicgstab, op, mg, projection)?
                     }
                 };
                 if closed {
