@@ -152,3 +152,28 @@ fn sort_keeps_ids_and_reports_particles_outside() {
         1
     );
 }
+
+/// The multigrid's coarse rows find their neighbours' blocks in lanes
+/// (`CellList::block_along_lanes`): the same blocks as `block_along` for points all over the
+/// grid, the grid's faces and the last cell of each axis (where the cell is clamped) included.
+#[test]
+fn blocks_in_lanes_are_the_blocks_of_single_points() {
+    use isph::math::lanes::{F64s, LANES};
+    let grid = CellList::<3>::new([-0.3, 0.0, 0.1], [0.7, 0.45, 0.9], 0.036, [true, false, false]);
+    let (lo, hi) = ([-0.3, 0.0, 0.1], [0.7, 0.45, 0.9]);
+    let mut state = 7;
+    for d in 0..3 {
+        let mut points: Vec<f64> = (0..4000)
+            .map(|_| lo[d] + (hi[d] - lo[d]) * lcg(&mut state))
+            .collect();
+        points.extend([lo[d], hi[d], hi[d] - 1e-12, lo[d] + 1e-12]);
+        for chunk in points.chunks(LANES) {
+            let mut lanes = [lo[d]; LANES];
+            lanes[..chunk.len()].copy_from_slice(chunk);
+            let blocks = grid.block_along_lanes(d, F64s::from(lanes)).to_array();
+            for (k, &x) in chunk.iter().enumerate() {
+                assert_eq!(blocks[k], grid.block_along(d, x) as f64, "axis {d}, x = {x}");
+            }
+        }
+    }
+}
