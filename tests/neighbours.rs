@@ -159,7 +159,12 @@ fn sort_keeps_ids_and_reports_particles_outside() {
 #[test]
 fn blocks_in_lanes_are_the_blocks_of_single_points() {
     use isph::math::lanes::{F64s, LANES};
-    let grid = CellList::<3>::new([-0.3, 0.0, 0.1], [0.7, 0.45, 0.9], 0.036, [true, false, false]);
+    let grid = CellList::<3>::new(
+        [-0.3, 0.0, 0.1],
+        [0.7, 0.45, 0.9],
+        0.036,
+        [true, false, false],
+    );
     let (lo, hi) = ([-0.3, 0.0, 0.1], [0.7, 0.45, 0.9]);
     let mut state = 7;
     for d in 0..3 {
@@ -172,7 +177,11 @@ fn blocks_in_lanes_are_the_blocks_of_single_points() {
             lanes[..chunk.len()].copy_from_slice(chunk);
             let blocks = grid.block_along_lanes(d, F64s::from(lanes)).to_array();
             for (k, &x) in chunk.iter().enumerate() {
-                assert_eq!(blocks[k], grid.block_along(d, x) as f64, "axis {d}, x = {x}");
+                assert_eq!(
+                    blocks[k],
+                    grid.block_along(d, x) as f64,
+                    "axis {d}, x = {x}"
+                );
             }
         }
     }
