@@ -27,7 +27,7 @@
 //! φ' = φ + (∇φ)·δr.
 
 use crate::math::lanes::{F64s, Sum};
-use crate::neighbours::Neighbours;
+use crate::neighbours::{Lanes, Neighbours};
 use crate::particles::Particles;
 use crate::scene::ShiftingSettings;
 use crate::sph::volume_gradient_factor;
@@ -73,18 +73,42 @@ impl Shifting {
         i: usize,
     ) -> [f64; D] {
         let mut grad = [Sum::ZERO; D];
+        nb.for_each_lanes(i, |l| {
+            self.add_pairs(nb, l, volume_gradient_factor(nb, p, l), &mut grad)
+        });
+        self.of_gradient(grad, surface_normal, full_support)
+    }
+
+    /// Adds the pairs of the lanes `l`, whose V_j ∇W_ij factor is `vf`
+    /// (`volume_gradient_factor`), to the sum `grad` of ∇C_i: a walk of its own
+    /// (`displacement`) or another's (`sph::velocity_gradient_and`).
+    #[inline(always)]
+    pub fn add_pairs<const D: usize>(
+        &self,
+        nb: &Neighbours<D>,
+        l: &Lanes<D>,
+        vf: F64s,
+        grad: &mut [Sum; D],
+    ) {
         let (inv_w_dx, weight) = (
             F64s::splat(1.0 / self.w_dx),
             F64s::splat(self.clustering_weight),
         );
-        nb.for_each_lanes(i, |l| {
-            let ratio = nb.kernel.w_lanes(l.r) * inv_w_dx;
-            let ratio2 = ratio * ratio;
-            let c = volume_gradient_factor(nb, p, l) * weight.mul_add(ratio2 * ratio2, F64s::ONE);
-            for d in 0..D {
-                grad[d] = grad[d].mul_add(c, l.rij[d]);
-            }
-        });
+        let ratio = nb.kernel.w_lanes(l.r) * inv_w_dx;
+        let ratio2 = ratio * ratio;
+        let c = vf * weight.mul_add(ratio2 * ratio2, F64s::ONE);
+        for d in 0..D {
+            grad[d] = grad[d].mul_add(c, l.rij[d]);
+        }
+    }
+
+    /// δr_i of Eq. (10) from the sum of ∇C_i over i's neighbours (`add_pairs`).
+    pub fn of_gradient<const D: usize>(
+        &self,
+        grad: [Sum; D],
+        surface_normal: [f64; D],
+        full_support: bool,
+    ) -> [f64; D] {
         let mut grad_c = grad.map(|g| g.total());
         if !full_support {
             let n = surface_normal;

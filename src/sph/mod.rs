@@ -128,9 +128,24 @@ pub fn velocity_gradient<const D: usize>(
     u: impl Fn(&Lanes<D>) -> [F64s; D],
     i: usize,
 ) -> [[f64; D]; D] {
+    velocity_gradient_and(nb, p, l, u_i, u, i, |_, _| {})
+}
+
+/// `velocity_gradient`, handing `also` each chunk of the walk with its V_j ∇W_ij factor
+/// (`volume_gradient_factor`): another sum over the same neighbours in the same walk.
+pub fn velocity_gradient_and<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Correction<D>,
+    u_i: [f64; D],
+    u: impl Fn(&Lanes<D>) -> [F64s; D],
+    i: usize,
+    mut also: impl FnMut(&Lanes<D>, F64s),
+) -> [[f64; D]; D] {
     let mut g = [[Sum::ZERO; D]; D];
     nb.for_each_lanes(i, |lanes| {
         let vf = volume_gradient_factor(nb, p, lanes);
+        also(lanes, vf);
         let u_j = u(lanes);
         for a in 0..D {
             let du = vf * (u_j[a] - F64s::splat(u_i[a]));

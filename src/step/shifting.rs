@@ -6,8 +6,9 @@ use super::free_surface::Surface;
 use super::{Stage, StepSettings};
 use crate::boundary::faces::{self, Faces};
 use crate::effects::shifting as fickian;
+use crate::math::lanes::Sum;
 use crate::math::memory::ArraySize;
-use crate::math::reduce::{self, fill_vector};
+use crate::math::reduce;
 use crate::neighbours::{Lanes, Neighbours};
 use crate::particles::{components, Kind, Particles};
 use crate::scene::ShiftingSettings;
@@ -58,38 +59,47 @@ impl<const D: usize> Shifting<D> {
             .expect("the free-surface stage keeps normals for shifting");
         let (roles, full) = (surface.roles, surface.full_support);
         let touch = faces::touching_distance(set.spacing);
-        fill_vector(&mut self.shift, |i| match roles[i] {
-            // A body's particles move rigidly (`rigid_bodies`): no shift, and no Taylor
-            // correction of their velocity.
-            _ if p.kind[i] == Kind::Body => [0.0; D],
-            // Splashes are left in place: neither ∇C nor the Taylor correction means anything
-            // there.
-            Role::Interior | Role::Surface | Role::Reference => {
-                let dr = shifting.displacement(nb, p, normals[i], full[i], i);
-                faces.no_penetration(p.position(i), dr, touch)
-            }
-            Role::Splash => [0.0; D],
-        });
-        if let Some(density) = density {
-            for (shift, density) in self.shift.iter_mut().zip(density) {
-                shift.iter_mut().zip(density).for_each(|(s, d)| *s += d);
-            }
-        }
-        let shift = &self.shift;
-        fill_vector(velocity, |i| {
+        reduce::fill_vector_and_update(&mut self.shift, velocity, |i, _| {
+            // A body's particles move rigidly (`rigid_bodies`): no shift; splashes are left in
+            // place: ∇C means nothing there.
+            let shifted = p.kind[i] != Kind::Body && roles[i] != Role::Splash;
             // Where the free surface is in reach the velocity gradient is no longer that of a
             // filled support, and shifting moves particles into the thinning, faster parts of a
             // stretching flow: the Taylor step there feeds the flow energy
             // (docs/stabilisation.md, "Near the free surface only: the divergence correction
             // and the Taylor step").
-            if !full[i] {
-                return p.velocity(i);
-            }
             let u_i = p.velocity(i);
-            let u = |l: &Lanes<D>| sph::fluid_velocity(p, u_i, l);
-            let g = sph::velocity_gradient(nb, p, corrections.of(i), u_i, u, i);
-            let dr = vector(shift, i);
-            std::array::from_fn(|a| p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
+            let mut grad_c = [Sum::ZERO; D];
+            let g = full[i].then(|| {
+                let u = |l: &Lanes<D>| sph::fluid_velocity(p, u_i, l);
+                let c = corrections.of(i);
+                sph::velocity_gradient_and(nb, p, c, u_i, u, i, |l, vf| {
+                    if shifted {
+                        shifting.add_pairs(nb, l, vf, &mut grad_c)
+                    }
+                })
+            });
+            let own = match (shifted, &g) {
+                (false, _) => [0.0; D],
+                (true, Some(_)) => shifting.of_gradient(grad_c, normals[i], full[i]),
+                (true, None) => shifting.displacement(nb, p, normals[i], full[i], i),
+            };
+            let own = if shifted {
+                faces.no_penetration(p.position(i), own, touch)
+            } else {
+                own
+            };
+            let dr = match density {
+                Some(x) => std::array::from_fn(|d| own[d] + x[d][i]),
+                None => own,
+            };
+            let u = match g {
+                Some(g) => std::array::from_fn(|a| {
+                    p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>()
+                }),
+                None => u_i,
+            };
+            (dr, u)
         });
         &self.shift
     }
