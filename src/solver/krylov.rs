@@ -259,6 +259,10 @@ impl<'a> Run<'a> {
                 relative_residual: 0.0,
                 converged: true,
             }));
+        } else if run.x.iter().all(|&x| x == 0.0) {
+            // A start from zero: A x₀ = 0 without an apply (the density correction's solve).
+            run.work.r.fill(0.0);
+            run.absorb();
         }
         run
     }
