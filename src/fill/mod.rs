@@ -24,27 +24,42 @@ pub fn build<const D: usize>(scene: &Scene) -> Particles<D> {
     let in_obstacle = |x: &[f64; D]| in_obstacle(scene, x);
     let kept_clear = |x: &[f64; D]| near_obstacle(scene, x) || in_a_body(scene, x);
 
-    let amplitude = scene.perturbation * dx;
-    let on_lattice = (amplitude > 0.0).then(|| NearOpenSpace::new(scene, lattice_reach(scene)));
-    let mut particles = Particles::<D>::default();
+    // What each lattice point holds, found once: the fluid's points, and the open space that
+    // the perturbation keeps its distance from.
+    let mut filling = Vec::with_capacity(cells.iter().product::<i64>() as usize);
     for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
         let x = point(k);
-        if let (Some(b), false) = (block_of(scene, &x), kept_clear(&x)) {
-            let fluid = &scene.fluids[b.fluid];
-            let pos = match &on_lattice {
-                Some(near) if !near.contains(k) => perturbed(x, k, amplitude),
-                _ => x,
-            };
-            particles.push(NewParticle {
-                pos,
-                kind: Kind::Fluid,
-                normal: [0.0; D],
-                fluid: b.fluid as u16,
-                mass: fluid.density * volume,
-                rest_density: fluid.density,
-                viscosity: fluid.viscosity,
-            });
-        }
+        filling.push(match (block_of(scene, &x), kept_clear(&x)) {
+            (Some(b), false) => Filling::Fluid(b.fluid as u16),
+            (None, false) => Filling::Open,
+            (_, true) => Filling::Solid,
+        });
+    });
+    let amplitude = scene.perturbation * dx;
+    let on_lattice = (amplitude > 0.0).then(|| {
+        let open = filling.iter().map(|f| *f == Filling::Open).collect();
+        NearOpenSpace::new(cells, open, lattice_reach(scene), &scene.periodic)
+    });
+    let mut particles = Particles::<D>::default();
+    let mut points = filling.into_iter();
+    for_each_lattice_point(std::array::from_fn(|_| 0), cells, |k| {
+        let Some(Filling::Fluid(f)) = points.next() else {
+            return;
+        };
+        let (x, fluid) = (point(k), &scene.fluids[f as usize]);
+        let pos = match &on_lattice {
+            Some(near) if !near.contains(k) => perturbed(x, k, amplitude),
+            _ => x,
+        };
+        particles.push(NewParticle {
+            pos,
+            kind: Kind::Fluid,
+            normal: [0.0; D],
+            fluid: f,
+            mass: fluid.density * volume,
+            rest_density: fluid.density,
+            viscosity: fluid.viscosity,
+        });
     });
     let faces = Faces::new(&scene.container, &scene.periodic, &scene.obstacles);
     let wall_density = scene.fluids[0].density;
@@ -177,6 +192,17 @@ pub fn fills_container<const D: usize>(scene: &Scene, particles: &Particles<D>) 
         room += !(near_obstacle(scene, &x) || in_a_body(scene, &x)) as usize;
     });
     particles.fluid_count() == room
+}
+
+/// What a lattice point of the container holds at t = 0.
+#[derive(Clone, Copy, PartialEq)]
+enum Filling {
+    /// A fluid particle, of this fluid.
+    Fluid(u16),
+    /// Nothing: open space, above a free surface.
+    Open,
+    /// An obstacle or a body, or the half spacing kept clear beside an obstacle.
+    Solid,
 }
 
 /// Lattice points per axis inside the container.

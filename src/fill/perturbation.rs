@@ -18,7 +18,6 @@
 //! pressure. Kept on the lattice, the surface starts flat and the still water of
 //! `scenes/hydrostatic_2d.toml` moves a hundred times slower (docs/accuracy.md).
 
-use super::{block_of, container_cells, in_a_body, lattice_point, near_obstacle};
 use crate::math::lattice::for_each_lattice_point;
 use crate::scene::Scene;
 
@@ -35,18 +34,12 @@ pub struct NearOpenSpace<const D: usize> {
 }
 
 impl<const D: usize> NearOpenSpace<D> {
-    pub fn new(scene: &Scene, reach: i64) -> Self {
-        let cells = container_cells::<D>(scene);
-        let mut near = Vec::with_capacity(cells.iter().product::<i64>() as usize);
-        for_each_lattice_point([0; D], cells, |k| {
-            let x = lattice_point(scene, k);
-            let filled =
-                block_of(scene, &x).is_some() || near_obstacle(scene, &x) || in_a_body(scene, &x);
-            near.push(!filled);
-        });
-        let mut mask = Self { cells, near };
-        for axis in 0..D {
-            mask.dilate(axis, reach, scene.periodic[axis]);
+    /// From `open`, whether each of the `cells` lattice points (x fastest) is open space, and
+    /// which axes are `periodic`.
+    pub fn new(cells: [i64; D], open: Vec<bool>, reach: i64, periodic: &[bool]) -> Self {
+        let mut mask = Self { cells, near: open };
+        for (axis, &periodic) in periodic.iter().enumerate().take(D) {
+            mask.dilate(axis, reach, periodic);
         }
         mask
     }

@@ -166,14 +166,13 @@ impl<const D: usize> PressureSolve<D> {
                     Role::Interior | Role::Surface => p.pressure[i] - level,
                     Role::Splash | Role::Reference => 0.0,
                 });
-                let projection = (&rhs[..], &mut pressure[..], set.solver);
                 let info = match density {
-                    None => bicgstab.solve(op, mg, projection.0, projection.1, set.solver)?,
+                    None => bicgstab.solve(op, mg, rhs, pressure, set.solver)?,
                     Some(d) => {
                         let rate = set.alpha / step.limit;
                         let full = s.full_support;
                         ppe::density_source(op, closed, sealed, full, step.dt, rate, &mut d.rhs);
-                        d.solve_beside(bicgstab, op, mg, projection)?
+                        d.solve_beside(bicgstab, op, mg, (rhs, pressure, set.solver))?
                     }
                 };
                 if closed {

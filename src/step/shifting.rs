@@ -59,7 +59,7 @@ impl<const D: usize> Shifting<D> {
             .expect("the free-surface stage keeps normals for shifting");
         let (roles, full) = (surface.roles, surface.full_support);
         let touch = faces::touching_distance(set.spacing);
-        reduce::fill_vector_and_update(&mut self.shift, velocity, |i, _| {
+        reduce::fill_vector_and_update(&mut self.shift, velocity, |i, u_i| {
             // A body's particles move rigidly (`rigid_bodies`): no shift; splashes are left in
             // place: ∇C means nothing there.
             let shifted = p.kind[i] != Kind::Body && roles[i] != Role::Splash;
@@ -67,8 +67,7 @@ impl<const D: usize> Shifting<D> {
             // filled support, and shifting moves particles into the thinning, faster parts of a
             // stretching flow: the Taylor step there feeds the flow energy
             // (docs/stabilisation.md, "Near the free surface only: the divergence correction
-            // and the Taylor step").
-            let u_i = p.velocity(i);
+            // and the Taylor step"). Where it runs, ∇C is summed in the same walk.
             let mut grad_c = [Sum::ZERO; D];
             let g = full[i].then(|| {
                 let u = |l: &Lanes<D>| sph::fluid_velocity(p, u_i, l);
@@ -79,24 +78,23 @@ impl<const D: usize> Shifting<D> {
                     }
                 })
             });
-            let own = match (shifted, &g) {
-                (false, _) => [0.0; D],
-                (true, Some(_)) => shifting.of_gradient(grad_c, normals[i], full[i]),
-                (true, None) => shifting.displacement(nb, p, normals[i], full[i], i),
-            };
             let own = if shifted {
-                faces.no_penetration(p.position(i), own, touch)
+                let dr = match g {
+                    Some(_) => shifting.of_gradient(grad_c, normals[i], full[i]),
+                    None => shifting.displacement(nb, p, normals[i], full[i], i),
+                };
+                faces.no_penetration(p.position(i), dr, touch)
             } else {
-                own
+                [0.0; D]
             };
             let dr = match density {
                 Some(x) => std::array::from_fn(|d| own[d] + x[d][i]),
                 None => own,
             };
             let u = match g {
-                Some(g) => std::array::from_fn(|a| {
-                    p.vel[a][i] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>()
-                }),
+                Some(g) => {
+                    std::array::from_fn(|a| u_i[a] + (0..D).map(|b| dr[b] * g[b][a]).sum::<f64>())
+                }
                 None => u_i,
             };
             (dr, u)
