@@ -104,6 +104,97 @@ fn bicgstab_matches_a_dense_solve_of_a_nonsymmetric_system() {
     assert!(info.iterations <= 1, "{info:?}");
 }
 
+/// The operator of `ConvectionDiffusion` that counts its applies.
+struct Counted<'a> {
+    a: &'a ConvectionDiffusion,
+    applies: std::sync::atomic::AtomicUsize,
+}
+
+impl LinearOperator for Counted<'_> {
+    fn len(&self) -> usize {
+        self.a.len()
+    }
+    fn apply(&self, x: &[f64], y: &mut [f64]) {
+        self.applies
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.a.apply(x, y);
+    }
+    fn diagonal(&self, d: &mut [f64]) {
+        self.a.diagonal(d);
+    }
+}
+
+fn true_relative_residual(a: &ConvectionDiffusion, b: &[f64], x: &[f64]) -> f64 {
+    let mut ax = vec![0.0; a.n];
+    a.apply(x, &mut ax);
+    let norm = |v: &mut dyn Iterator<Item = f64>| v.map(|e| e * e).sum::<f64>().sqrt();
+    norm(&mut b.iter().zip(&ax).map(|(b, ax)| b - ax)) / norm(&mut b.iter().copied())
+}
+
+/// A converged solve reports its recursively updated residual, which stays within rounding of
+/// the true one, and spends no apply on it: two per iteration and one for the start. A solve
+/// cut at its iteration limit reports the true residual, after one more apply.
+#[test]
+fn a_solve_reports_its_residual_without_an_apply_once_converged() {
+    let a = ConvectionDiffusion { n: 300, c: 0.4 };
+    let b: Vec<f64> = (0..a.n)
+        .map(|i| ((i * 29 % 13) as f64 - 6.0) / 6.0)
+        .collect();
+    let mut jacobi = Jacobi::default();
+    jacobi.setup(&a).unwrap();
+    for tolerance in [1e-3, 1e-6, 1e-10] {
+        let counted = Counted {
+            a: &a,
+            applies: 0.into(),
+        };
+        let mut x = vec![0.5; a.n];
+        let params = SolverParams {
+            tolerance,
+            max_iterations: 2000,
+        };
+        let info = BiCgStab::default()
+            .solve(&counted, &mut jacobi, &b, &mut x, params)
+            .unwrap();
+        let applies = counted.applies.into_inner();
+        let truth = true_relative_residual(&a, &b, &x);
+        assert!(
+            info.converged && info.relative_residual <= tolerance,
+            "{info:?}"
+        );
+        assert!(
+            (info.relative_residual - truth).abs() <= 1e-12,
+            "reported {} against the true {truth}",
+            info.relative_residual
+        );
+        // The last iteration may stop halfway, after its first apply.
+        let full = 1 + 2 * info.iterations;
+        assert!(
+            applies == full || applies == full - 1,
+            "{applies} applies, {info:?}"
+        );
+    }
+    let counted = Counted {
+        a: &a,
+        applies: 0.into(),
+    };
+    let mut x = vec![0.5; a.n];
+    let params = SolverParams {
+        tolerance: 1e-10,
+        max_iterations: 5,
+    };
+    let info = BiCgStab::default()
+        .solve(&counted, &mut jacobi, &b, &mut x, params)
+        .unwrap();
+    assert!(!info.converged && info.iterations == 5, "{info:?}");
+    assert_eq!(counted.applies.into_inner(), 1 + 2 * 5 + 1);
+    let truth = true_relative_residual(&a, &b, &x);
+    assert!(
+        (info.relative_residual - truth).abs() <= 1e-12 * truth,
+        "reported {} against the true {truth}",
+        info.relative_residual
+    );
+}
+
 /// Two systems solved in lockstep (`BiCgStab::solve_two`) end with the bits, iterations and
 /// residuals of the two solved one after the other, whichever is given first: here a tight
 /// solve from zero beside a loose one from a warm start, and a solve beside one whose

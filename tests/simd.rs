@@ -9,8 +9,8 @@ use isph::neighbours::Neighbours;
 use isph::particles::{Kind, NewParticle, Particles};
 use isph::solver::krylov::LinearOperator;
 use isph::solver::multigrid::Aggregated;
-use isph::solver::ppe::{self, PressureOperator, Role};
-use isph::sph::{self, Corrections};
+use isph::solver::ppe::{self, LaplacianTruncation, PressureOperator, Role};
+use isph::sph;
 
 const DX: f64 = 0.01;
 const H_OVER_DX: f64 = 1.2;
@@ -93,15 +93,17 @@ fn check<const D: usize>(n: i64) {
     let nf = grid.range_of(Kind::Fluid).end;
     let phi = |j: usize| 3.0 * p.pos[0][j] - 2.0 * p.pos[1][j] + 1.0;
     let roles = vec![Role::Interior; nf];
-    let mut row_vectors = std::array::from_fn(|_| vec![0.0; nf]);
-    ppe::row_vectors(
-        &nb,
-        &p,
-        None,
-        &roles,
-        Corrections::new(false, &[]),
-        &mut row_vectors,
-    );
+    // The row vectors as the free-surface stage sums them, in the moments' walk (no kernel
+    // correction: ĉ_i = c_i).
+    let row_vectors: Vec<[f64; D]> = (0..nf)
+        .map(|i| {
+            let mut truncation = LaplacianTruncation::new(&p, false, i);
+            sph::support_moments_and(&nb, &p, i, |l, followed| {
+                truncation.add(&nb, &p, l, followed)
+            });
+            ppe::row_vector(Role::Interior, &truncation, &None)
+        })
+        .collect();
     let mut fluid_volume = Vec::new();
     ppe::fluid_volumes(&p, nf, &mut fluid_volume);
     let op = PressureOperator {
@@ -171,8 +173,28 @@ fn check<const D: usize>(n: i64) {
                 "gradient of {i}, axis {d}: {fast:?} vs {grad:?}"
             );
         }
+        // The row vector c_i = 2 Σ_j (m_j/ρ_i) r_ij·∇W_ij/(r_ij² + η²) r_ij, a wall neighbour's
+        // r_ij cut to its part across the wall (`ppe::LaplacianTruncation`).
+        let c = row_vectors[i];
+        let (mut twin, mut size) = ([0.0; D], 0.0);
+        for &(j, rij, r) in &neighbours {
+            let a = 2.0 * p.mass[j] / p.rest_density[i] * nb.laplacian_factor(r);
+            for d in 0..D {
+                let followed = match p.kind[j] {
+                    Kind::Wall if p.normal[d][j] == 0.0 => 0.0,
+                    _ => rij[d],
+                };
+                twin[d] += a * followed;
+                size += (a * followed).abs();
+            }
+        }
+        for d in 0..D {
+            assert!(
+                close(c[d], twin[d], size),
+                "row vector of {i}, axis {d}: {c:?} vs {twin:?}"
+            );
+        }
         // The PPE row of Eq. (27) with its consistency correction, fluid neighbours only.
-        let c = std::array::from_fn::<f64, D, _>(|d| row_vectors[d][i]);
         let mut row = 0.0;
         let mut scale = 0.0;
         for &(j, rij, r) in neighbours.iter().filter(|&&(j, _, _)| j < nf) {

@@ -16,9 +16,9 @@
 //! fluid neighbours (`ghosts::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
 //! first in the sorted order).
 
-use crate::boundary::ghosts::{behind_walls, ghost_pressure_difference, ghost_velocity, BodyForce};
+use crate::boundary::ghosts::{ghost_pressure_difference, ghost_velocity, BodyForce};
 use crate::math::lanes::{F64s, Sum, LANES};
-use crate::math::reduce::{fill, fill_pair, fill_vector};
+use crate::math::reduce::{fill, fill_pair};
 use crate::neighbours::Lanes;
 use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
@@ -146,24 +146,28 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
     });
 }
 
-/// The per-row vector of the operator, with L'_i the correction of the pressure gradient
-/// (`sph::Moments::m_neumann`): ĉ_i = L'_iᵀ c_i of the consistent Laplacian for interior rows
-/// (see `laplacian_correction`), zero otherwise. Deep inside the fluid c_i measures the
-/// disorder of the particles, and the row is corrected all the same: left uncorrected, those
-/// rows let still water go unstable within seconds, and with the correction the tank stays at
-/// rest (docs/stabilisation.md, "The free-surface and interior rows of the PPE").
-pub fn row_vectors<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    interfaces: Option<Field<D>>,
-    roles: &[Role],
-    pressure_corrections: Corrections<D>,
-    out: &mut [Vec<f64>; D],
-) {
-    fill_vector(out, |i| match roles[i] {
-        Role::Interior => laplacian_correction(nb, p, interfaces, pressure_corrections.of(i), i),
+/// The per-row vector of the operator ĉ_i = L'_iᵀ c_i of the consistent Laplacian (see
+/// `LaplacianTruncation`), with L'_i the correction of the pressure gradient
+/// (`sph::Moments::m_neumann`), for interior rows; zero for the others, which couple nothing.
+/// Deep inside the fluid c_i measures the disorder of the particles, and the row is corrected
+/// all the same: left uncorrected, those rows let still water go unstable within seconds, and
+/// with the correction the tank stays at rest (docs/stabilisation.md, "The free-surface and
+/// interior rows of the PPE").
+pub fn row_vector<const D: usize>(
+    role: Role,
+    truncation: &LaplacianTruncation<D>,
+    l: &Correction<D>,
+) -> [f64; D] {
+    match role {
+        Role::Interior => {
+            let c = truncation.c.map(|x| x.total());
+            match l {
+                Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[b][a] * c[b]).sum()),
+                None => c,
+            }
+        }
         Role::Surface | Role::Splash | Role::Reference => [0.0; D],
-    });
+    }
 }
 
 /// Pressure of a free-surface particle: the surface itself lies about δ = dx/2 beyond the
@@ -390,38 +394,52 @@ fn volume_mass<const D: usize>(
 /// surface meets a wall the support is truncated for the tangential part too. Subtracting that
 /// term, with ∇P_i the corrected gradient L_i Σ_j V_j (P_j − P_i)∇W_ij, gives the row Σ_j (a_ij −
 /// V_j (L_iᵀc_i)·∇W_ij)(P_i − P_j), still one pass over the neighbours. Without it the pressure
-/// bends under the free surface and pushes a still surface off its rest position. Returns ĉ_i =
-/// L_iᵀ c_i, with L_i the pressure gradient correction.
-fn laplacian_correction<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    interfaces: Option<Field<D>>,
-    l: &Correction<D>,
-    i: usize,
-) -> [f64; D] {
-    let mut c = [Sum::ZERO; D];
-    let scale = F64s::splat(2.0 / p.rest_density[i]);
-    let row = Side::of(p, interfaces, i);
-    nb.for_each_lanes(i, |lanes| {
-        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(lanes.r);
+/// bends under the free surface and pushes a still surface off its rest position.
+///
+/// c_i is summed in the walk of the support's moments (`sph::support_moments_and`, the free
+/// surface stage), which visits the same neighbours and finds the part of r_ij a wall ghost
+/// follows: no walk of its own.
+pub struct LaplacianTruncation<const D: usize> {
+    c: [Sum; D],
+    /// 2/ρ0_i.
+    scale: F64s,
+    /// ρ0_i, where the fluids differ in rest density (None: one density).
+    rest_density: Option<F64s>,
+}
+
+impl<const D: usize> LaplacianTruncation<D> {
+    /// The sum for particle i; `fluids_differ`: the scene's fluids differ in rest density.
+    pub fn new(p: &Particles<D>, fluids_differ: bool, i: usize) -> Self {
+        let rest_density = p.rest_density[i];
+        Self {
+            c: [Sum::ZERO; D],
+            scale: F64s::splat(2.0 / rest_density),
+            rest_density: fluids_differ.then(|| F64s::splat(rest_density)),
+        }
+    }
+
+    /// Adds the neighbours `l`, whose r_ij a pressure field follows as `followed`.
+    #[inline(always)]
+    pub fn add(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        l: &Lanes<D>,
+        followed: &[F64s; D],
+    ) {
+        let (_, laplacian_factor) = nb.gradient_and_laplacian_factors_lanes(l.r);
         // −a_ij of Eq. (27) (`sph::laplacian_coefficient`) for the kernel's truncation alone:
         // across an interface the pairs are weighted by design (`interior_weights`), and taken
         // for truncation that weighting would be undone, leaving one fluid's pressure gradient
         // through both.
-        let mass = volume_mass(p, interfaces.is_some(), &row, lanes);
-        let cl = (scale * mass * laplacian_factor) & lanes.mask;
-        let followed = match lanes.kind {
-            Kind::Fluid | Kind::Body => lanes.rij,
-            Kind::Wall => behind_walls(p, lanes, lanes.rij),
+        let mass = match self.rest_density {
+            Some(rest_density) => mass_at_density(p, rest_density, l),
+            None => l.load(&p.mass),
         };
+        let cl = (self.scale * mass * laplacian_factor) & l.mask;
         for d in 0..D {
-            c[d] = c[d].mul_add(cl, followed[d]);
+            self.c[d] = self.c[d].mul_add(cl, followed[d]);
         }
-    });
-    let c = c.map(|x| x.total());
-    match l {
-        Some(l) => std::array::from_fn(|a| (0..D).map(|b| l[b][a] * c[b]).sum()),
-        None => c,
     }
 }
 
@@ -430,8 +448,8 @@ pub struct PressureOperator<'a, const D: usize> {
     pub nb: &'a Neighbours<'a, D>,
     pub p: &'a Particles<D>,
     pub roles: &'a [Role],
-    /// The row vectors of `row_vectors`.
-    pub row_vectors: &'a [Vec<f64>; D],
+    /// The row vectors ĉ_i of `row_vector`.
+    pub row_vectors: &'a [[f64; D]],
     /// V_j = m_j/ρ0_j of the fluid particles, the unknowns the rows couple (`fluid_volumes`).
     pub fluid_volume: &'a [f64],
     pub gravity: [f64; D],
@@ -454,7 +472,7 @@ impl<const D: usize> PressureOperator<'_, D> {
     fn row_constants(&self, i: usize) -> Row<D> {
         Row {
             scale: F64s::splat(-2.0 / self.p.rest_density[i]),
-            c: std::array::from_fn(|d| F64s::splat(self.row_vectors[d][i])),
+            c: self.row_vectors[i].map(F64s::splat),
             density: Side::of(self.p, self.interfaces, i),
         }
     }

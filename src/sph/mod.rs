@@ -19,12 +19,28 @@ use crate::particles::{Kind, Particles};
 /// taken for expanded (below 0.9 ρ0 it would be spray: `free_surface::spray_density`) nor the oil
 /// for compressed. The kernel's `density_scale` makes it ρ0 on the rest lattice.
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
+    density_and_nearest(nb, p, i).0
+}
+
+/// The summation density of `density` and, from the same walk, the distance from particle i
+/// to its nearest neighbour of any kind (infinite where it has none), which the particle
+/// disorder of `stats.csv` is measured from.
+pub fn density_and_nearest<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+) -> (f64, f64) {
     let mut rho = Sum::ZERO;
     let rho0_i = F64s::splat(p.rest_density[i]);
+    let far = F64s::splat(f64::INFINITY);
+    let mut nearest = far;
     nb.for_each_lanes(i, |l| {
         rho += (mass_at_density(p, rho0_i, l) * nb.kernel.w_lanes(l.r)) & l.mask;
+        nearest = nearest.fast_min(l.mask.select(l.r, far));
     });
-    (p.mass[i] * nb.kernel.w(0.0) + rho.total()) * nb.kernel.density_scale()
+    let rho = (p.mass[i] * nb.kernel.w(0.0) + rho.total()) * nb.kernel.density_scale();
+    let nearest = nearest.to_array().into_iter().fold(f64::INFINITY, f64::min);
+    (rho, nearest)
 }
 
 /// m_j ρ0_i/ρ0_j = ρ0_i V_j of the lanes: the mass of neighbour j's volume at particle i's rest
@@ -254,6 +270,19 @@ pub fn support_moments<const D: usize>(
     p: &Particles<D>,
     i: usize,
 ) -> Moments<D> {
+    support_moments_and(nb, p, i, |_, _| {})
+}
+
+/// The support moments of particle i, handing each chunk of neighbours `l` on to `also` with
+/// the part of r_ij a pressure field follows there (`Moments::m_neumann`): a sum over the same
+/// support in the same walk (the PPE's row vector, `ppe::LaplacianTruncation`).
+#[inline(always)]
+pub fn support_moments_and<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    i: usize,
+    mut also: impl FnMut(&Lanes<D>, &[F64s; D]),
+) -> Moments<D> {
     let (mut m, mut m_neumann) = ([[Sum::ZERO; D]; D], [[Sum::ZERO; D]; D]);
     let (mut grad_c, mut fluid_neighbours) = ([Sum::ZERO; D], 0);
     nb.for_each_lanes(i, |l| {
@@ -267,6 +296,7 @@ pub fn support_moments<const D: usize>(
             }
             Kind::Wall => behind_walls(p, l, l.rij),
         };
+        also(l, &followed);
         for a in 0..D {
             let v = vf * l.rij[a];
             grad_c[a] += v;

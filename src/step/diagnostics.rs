@@ -2,9 +2,7 @@
 //! the fluid with a full kernel support, and the largest speed and the kinetic energy.
 
 use super::{Stage, StepSettings};
-use crate::math::lanes::F64s;
 use crate::math::reduce;
-use crate::neighbours::Neighbours;
 use crate::particles::Particles;
 
 pub const NAME: &str = "diagnostics";
@@ -15,27 +13,22 @@ pub struct Diagnostics;
 /// summation density is not truncated), in one pass:
 /// - the density error, mean |ρ/ρ0 − 1|;
 /// - the particle disorder, the coefficient of variation (standard deviation over mean) of
-///   the distance from each particle to its nearest neighbour: zero on a lattice, a few per
-///   cent when particles stay well spread, growing as they cluster into lines and gaps
-///   (tensile instability, no shifting).
+///   the distance from each particle to its nearest neighbour (`nearest`, from the density's
+///   walk): zero on a lattice, a few per cent when particles stay well spread, growing as they
+///   cluster into lines and gaps (tensile instability, no shifting).
 ///
 /// NaN for both where no particle has a full support (nothing measured, not a zero error).
 pub fn full_support_statistics<const D: usize>(
-    nb: &Neighbours<D>,
     p: &Particles<D>,
     full: &[bool],
+    nearest: &[f64],
 ) -> (f64, f64) {
     let [count, density, distance, square] = reduce::sums(full.len(), |i| {
         if !full[i] {
             return [0.0; 4];
         }
-        let mut nearest = F64s::splat(f64::INFINITY);
-        nb.for_each_lanes(i, |l| {
-            nearest = nearest.fast_min(l.mask.select(l.r, F64s::splat(f64::INFINITY)));
-        });
-        let nearest = nearest.to_array().into_iter().fold(f64::INFINITY, f64::min);
         let error = (p.density[i] / p.rest_density[i] - 1.0).abs();
-        [1.0, error, nearest, nearest * nearest]
+        [1.0, error, nearest[i], nearest[i] * nearest[i]]
     });
     if count == 0.0 {
         return (f64::NAN, f64::NAN);

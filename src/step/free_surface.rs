@@ -1,14 +1,15 @@
-//! How each kernel support is filled, from its moments (`sph::support_moments`): the free
+//! How each kernel support is filled, from its moments (`sph::support_moments_and`): the free
 //! surface and the role of each fluid particle in the PPE (`ppe::role`), the particles with no
-//! free surface in reach, and the corrections the moments give at no extra pass: the pressure
-//! gradient's L'_i of Eq. (25) with the kernel correction, the surface normal with shifting.
+//! free surface in reach, and what the same walk gives at no extra pass: the pressure
+//! gradient's L'_i of Eq. (25) with the kernel correction, the surface normal with shifting,
+//! and the PPE's row vectors ĉ_i (`ppe::row_vector`).
 
 use super::{Stage, StepSettings};
 use crate::math::memory::ArraySize;
 use crate::neighbours::Neighbours;
 use crate::particles::Particles;
 use crate::scene::Effects;
-use crate::solver::ppe::{self, Role};
+use crate::solver::ppe::{self, LaplacianTruncation, Role};
 use crate::sph::free_surface::Support;
 use crate::sph::{self, Correction, Corrections};
 use rayon::iter::Either;
@@ -29,6 +30,8 @@ pub struct FreeSurface<const D: usize> {
     /// The free surface's outward normal of each fluid particle, where shifting keeps to the
     /// tangential direction (with shifting).
     surface_normal: Option<Vec<[f64; D]>>,
+    /// The PPE's row vectors ĉ_i (`ppe::row_vector`).
+    row_vectors: Vec<[f64; D]>,
 }
 
 /// What the stage found, for the stages after it.
@@ -41,6 +44,8 @@ pub struct Surface<'a, const D: usize> {
     pub pressure_corrections: Corrections<'a, D>,
     /// The outward normals (with shifting).
     pub normals: Option<&'a [[f64; D]]>,
+    /// The PPE's row vectors ĉ_i.
+    pub row_vectors: &'a [[f64; D]],
 }
 
 impl<const D: usize> FreeSurface<D> {
@@ -51,14 +56,23 @@ impl<const D: usize> FreeSurface<D> {
             full_support: Vec::new(),
             pressure_corrections: effects.kernel_correction.then(Vec::new),
             surface_normal: effects.shifting.map(|_| Vec::new()),
+            row_vectors: Vec::new(),
         }
     }
 
     /// Classifies the `nf` fluid particles, inverting L'_i from the same moments (once per step
-    /// for every operator after it).
-    pub fn run(&mut self, nb: &Neighbours<D>, p: &Particles<D>, set: &StepSettings<D>, nf: usize) {
+    /// for every operator after it); `fluids_differ`: the scene's fluids differ in rest density.
+    pub fn run(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        set: &StepSettings<D>,
+        fluids_differ: bool,
+        nf: usize,
+    ) {
         let n = nf;
         self.roles.resize(n, Role::Interior);
+        self.row_vectors.resize(n, [0.0; D]);
         let corrections = match &mut self.pressure_corrections {
             Some(l) => {
                 l.resize(n, None);
@@ -75,11 +89,15 @@ impl<const D: usize> FreeSurface<D> {
         };
         self.roles
             .par_iter_mut()
+            .zip(&mut self.row_vectors)
             .zip(normals)
             .zip(corrections)
             .enumerate()
-            .for_each(|(i, ((role, normal), corrections))| {
-                let mo = sph::support_moments(nb, p, i);
+            .for_each(|(i, (((role, row_vector), normal), corrections))| {
+                let mut truncation = LaplacianTruncation::new(p, fluids_differ, i);
+                let mo = sph::support_moments_and(nb, p, i, |l, followed| {
+                    truncation.add(nb, p, l, followed)
+                });
                 let l_pressure =
                     sph::gradient_correction(mo.m_neumann, set.min_correction_determinant);
                 let support = Support::new(&mo.m, mo.grad_c);
@@ -99,6 +117,7 @@ impl<const D: usize> FreeSurface<D> {
                         i,
                     )
                 };
+                *row_vector = ppe::row_vector(*role, &truncation, &l_pressure);
                 if let Some(normal) = normal {
                     *normal = support.normal;
                 }
@@ -107,6 +126,9 @@ impl<const D: usize> FreeSurface<D> {
                 }
             });
         self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
+        if let Some(reference) = self.reference {
+            self.row_vectors[reference] = [0.0; D];
+        }
         ppe::full_support(nb, &self.roles, &mut self.full_support);
     }
 
@@ -118,6 +140,7 @@ impl<const D: usize> FreeSurface<D> {
     /// pressure solve's sealed regions).
     pub fn pin(&mut self, i: usize) {
         self.roles[i] = Role::Reference;
+        self.row_vectors[i] = [0.0; D];
     }
 
     pub fn output(&self) -> Surface<'_, D> {
@@ -127,6 +150,7 @@ impl<const D: usize> FreeSurface<D> {
             full_support: &self.full_support,
             pressure_corrections: self.pressure_corrections(),
             normals: self.surface_normal.as_deref(),
+            row_vectors: &self.row_vectors,
         }
     }
 
@@ -151,6 +175,8 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
         if self.surface_normal.is_some() {
             what += "; the surface normal, for the shifting";
         }
+        what +=
+            "; the PPE rows' vectors ĉ_i of the consistent Laplacian (Eq. 27), in the same walk";
         what
     }
 
@@ -158,6 +184,7 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
         let mut arrays = vec![
             ArraySize::of("PPE role", &self.roles),
             ArraySize::of("full support", &self.full_support),
+            ArraySize::of("PPE row vector", &self.row_vectors),
         ];
         if let Some(l) = &self.pressure_corrections {
             arrays.push(ArraySize::of("L'", l));

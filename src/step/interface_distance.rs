@@ -28,13 +28,7 @@ impl<const D: usize> InterfaceDistance<D> {
 
     /// The distances and normals of the `nf` fluid particles, from the other fluid's share of
     /// each kernel, the container's faces mirroring the fluid.
-    pub fn run(
-        &mut self,
-        nb: &Neighbours<D>,
-        p: &Particles<D>,
-        faces: &Faces,
-        nf: usize,
-    ) -> interface::Field<'_, D> {
+    pub fn run(&mut self, nb: &Neighbours<D>, p: &Particles<D>, faces: &Faces, nf: usize) {
         let support = nb.kernel.support();
         self.distance.resize(nf, 0.0);
         for n in &mut self.normal {
@@ -46,6 +40,10 @@ impl<const D: usize> InterfaceDistance<D> {
             let (share, gradient) = interface::other_fluid_share(nb, p, mirrors, i);
             (table.distance(share), unit(gradient))
         });
+    }
+
+    /// The distances and normals of the last `run`.
+    pub fn field(&self) -> interface::Field<'_, D> {
         interface::Field {
             distance: &self.distance,
             normal: &self.normal,

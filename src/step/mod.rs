@@ -332,12 +332,12 @@ impl<const D: usize> Step<D> {
             let nb = Neighbours::new(self.cell_list.grid(), &p.pos, self.kernel);
             // The time-step limit is in no stage (`isph bench`'s "other").
             laps.skip();
-            let density = self.density.run(&nb, p, nf);
+            self.density.run(&nb, p, &self.faces, nf);
             // Into the particles: ρ.
-            p.density[..nf].copy_from_slice(density);
-            let interfaces = self.density.interfaces(&nb, p, &self.faces, nf);
+            p.density[..nf].copy_from_slice(self.density.density());
+            let interfaces = self.density.interfaces();
             laps.lap(density::NAME);
-            self.free_surface.run(&nb, p, set, nf);
+            self.free_surface.run(&nb, p, set, interfaces.is_some(), nf);
             laps.lap(free_surface::NAME);
             let full_support = self.free_surface.full_support();
             let corrections = match &mut self.kernel_correction {
@@ -426,8 +426,11 @@ impl<const D: usize> Step<D> {
             }
             // Into the particles: uⁿ⁺¹ (the bodies' rigid).
             copy_vector(velocity, &mut p.vel);
-            let (density_error, disorder) =
-                diagnostics::full_support_statistics(&nb, p, surface.full_support);
+            let (density_error, disorder) = diagnostics::full_support_statistics(
+                p,
+                surface.full_support,
+                self.density.nearest(),
+            );
             laps.part(diagnostics::NAME);
             if lands_on_target {
                 let ghosts = ghosts::Ghosts {

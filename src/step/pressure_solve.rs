@@ -14,7 +14,7 @@ use super::{Stage, StepSettings};
 use crate::math::memory::ArraySize;
 use crate::math::reduce::{self, fill};
 use crate::neighbours::Neighbours;
-use crate::particles::{components, Particles};
+use crate::particles::Particles;
 use crate::scene::GhostPressure;
 use crate::solver::krylov::{BiCgStab, Preconditioner, SolveInfo, SolverError, SolverParams};
 use crate::solver::multigrid::Multigrid;
@@ -33,7 +33,8 @@ pub const NAME: &str = "pressure solve";
 const DENSITY_TOLERANCE: f64 = 1e-2;
 
 pub struct PressureSolve<const D: usize> {
-    rows: Rows<D>,
+    /// V_j = m_j/ρ0_j of fluid particles (the unknowns of the PPE).
+    fluid_volume: Vec<f64>,
     rhs: Vec<f64>,
     /// The projection's solution (before the cavitation clip that the particles' pressure takes).
     pressure: Vec<f64>,
@@ -80,23 +81,12 @@ impl DensitySolve {
     }
 }
 
-/// The per-row arrays of the operator.
-struct Rows<const D: usize> {
-    /// The per-row vectors of the PPE operator (`ppe::row_vectors`).
-    row_vectors: [Vec<f64>; D],
-    /// V_j = m_j/ρ0_j of fluid particles (the unknowns of the PPE).
-    fluid_volume: Vec<f64>,
-}
-
 impl<const D: usize> PressureSolve<D> {
     /// The solve of a step whose density-invariance term is (`density_correction`) or is not
     /// (α = 0) solved for.
     pub fn new(density_correction: bool) -> Self {
         Self {
-            rows: Rows {
-                row_vectors: components(),
-                fluid_volume: Vec::new(),
-            },
+            fluid_volume: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
             bicgstab: BiCgStab::default(),
@@ -126,7 +116,7 @@ impl<const D: usize> PressureSolve<D> {
     ) -> Result<SolveInfo, SolverError> {
         let nf = surface.full_support().len();
         let Self {
-            rows,
+            fluid_volume,
             rhs,
             pressure,
             bicgstab,
@@ -135,7 +125,7 @@ impl<const D: usize> PressureSolve<D> {
         } = self;
         pressure.resize(nf, 0.0);
         with_operator(
-            rows,
+            fluid_volume,
             multigrid,
             nb,
             p,
@@ -204,7 +194,7 @@ impl<const D: usize> PressureSolve<D> {
 /// the second pass finds none).
 #[allow(clippy::too_many_arguments)]
 fn with_operator<const D: usize, R>(
-    rows: &mut Rows<D>,
+    fluid_volume: &mut Vec<f64>,
     multigrid: &mut Multigrid<D>,
     nb: &Neighbours<D>,
     p: &Particles<D>,
@@ -220,21 +210,7 @@ fn with_operator<const D: usize, R>(
     ) -> Result<R, SolverError>,
 ) -> Result<R, SolverError> {
     let n = surface.full_support().len();
-    for a in &mut rows.row_vectors {
-        a.resize(n, 0.0);
-    }
-    {
-        let s = surface.output();
-        ppe::row_vectors(
-            nb,
-            p,
-            interfaces,
-            s.roles,
-            s.pressure_corrections,
-            &mut rows.row_vectors,
-        );
-    }
-    ppe::fluid_volumes(p, n, &mut rows.fluid_volume);
+    ppe::fluid_volumes(p, n, fluid_volume);
     let mut sealed = Vec::new();
     let (op, s) = loop {
         let s = surface.output();
@@ -242,8 +218,8 @@ fn with_operator<const D: usize, R>(
             nb,
             p,
             roles: s.roles,
-            row_vectors: &rows.row_vectors,
-            fluid_volume: &rows.fluid_volume,
+            row_vectors: s.row_vectors,
+            fluid_volume,
             gravity: set.gravity,
             ghost_force: set.ghost_force(ghost),
             interfaces,
@@ -298,8 +274,7 @@ impl<const D: usize> Stage<D> for PressureSolve<D> {
 
     fn arrays(&self) -> Vec<ArraySize> {
         let mut arrays = vec![
-            ArraySize::of_components("row vector", &self.rows.row_vectors),
-            ArraySize::of("fluid volume", &self.rows.fluid_volume),
+            ArraySize::of("fluid volume", &self.fluid_volume),
             ArraySize::of("right-hand side", &self.rhs),
             ArraySize::of("pressure", &self.pressure),
         ];
