@@ -106,16 +106,41 @@ pub fn fill_vector_and_update<const D: usize>(
     b: &mut [Vec<f64>; D],
     f: impl Fn(usize, [f64; D]) -> ([f64; D], [f64; D]) + Sync,
 ) {
-    assert_eq!(a[0].len(), b[0].len(), "one vector per particle in each");
-    component_blocks(a)
+    update_vectors([a, b], |i, [_, b]| {
+        let (a, b) = f(i, b);
+        [a, b]
+    });
+}
+
+/// v_k[i] ← f(i, [v_0[i], …])[k] for every i and each of the K arrays of vectors `v` (SoA
+/// components): K per-particle vector results of one pass, each handed its old value.
+pub fn update_vectors<const D: usize, const K: usize>(
+    v: [&mut [Vec<f64>; D]; K],
+    f: impl Fn(usize, [[f64; D]; K]) -> [[f64; D]; K] + Sync,
+) {
+    let n = v[0][0].len();
+    assert!(
+        v.iter().all(|a| a[0].len() == n),
+        "one vector per particle in each"
+    );
+    let mut blocks = v.map(|a| component_blocks(a).into_iter());
+    let blocks: Vec<[[&mut [f64]; D]; K]> = (0..n.div_ceil(BLOCK))
+        .map(|_| {
+            blocks
+                .each_mut()
+                .map(|b| b.next().expect("arrays have equal length"))
+        })
+        .collect();
+    blocks
         .into_par_iter()
-        .zip(component_blocks(b))
         .enumerate()
-        .for_each(|(c, (mut block_a, mut block_b))| {
-            for k in 0..block_a[0].len() {
-                let (x, y) = f(c * BLOCK + k, std::array::from_fn(|d| block_b[d][k]));
-                set(&mut block_a, k, x);
-                set(&mut block_b, k, y);
+        .for_each(|(c, mut block)| {
+            for k in 0..block[0][0].len() {
+                let old = std::array::from_fn(|a| std::array::from_fn(|d| block[a][d][k]));
+                let new = f(c * BLOCK + k, old);
+                for (b, v) in block.iter_mut().zip(new) {
+                    set(b, k, v);
+                }
             }
         });
 }

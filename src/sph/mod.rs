@@ -485,14 +485,32 @@ pub fn gradient<const D: usize>(
     i: usize,
     difference: impl Fn(&Lanes<D>) -> F64s,
 ) -> [f64; D] {
-    let mut grad = [Sum::ZERO; D];
+    let [grad] = gradients(nb, p, l, i, |lanes| [difference(lanes)]);
+    grad
+}
+
+/// The corrected gradients of `gradient` of K scalar fields in one walk, with
+/// `differences(l)` the K fields' φ_j − φ_i: each with the bits of its own walk.
+#[inline]
+pub fn gradients<const D: usize, const K: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    l: &Correction<D>,
+    i: usize,
+    differences: impl Fn(&Lanes<D>) -> [F64s; K],
+) -> [[f64; D]; K] {
+    let mut grad = [[Sum::ZERO; D]; K];
     nb.for_each_lanes(i, |lanes| {
-        let c = volume_gradient_factor(nb, p, lanes) * difference(lanes);
-        for d in 0..D {
-            grad[d] = grad[d].mul_add(c, lanes.rij[d]);
+        let vf = volume_gradient_factor(nb, p, lanes);
+        let differences = differences(lanes);
+        for k in 0..K {
+            let c = vf * differences[k];
+            for d in 0..D {
+                grad[k][d] = grad[k][d].mul_add(c, lanes.rij[d]);
+            }
         }
     });
-    apply_correction(l, grad.map(|g| g.total()))
+    grad.map(|g| apply_correction(l, g.map(|g| g.total())))
 }
 
 /// Coefficient a_ij ≥ 0 of the negative Laplacian of Eq. (27):

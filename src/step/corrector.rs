@@ -1,6 +1,8 @@
 //! Corrector, Eq. (7): uⁿ⁺¹ = u* − (Δt/ρ0)∇Pⁿ⁺¹ with the corrected gradient and the walls as
 //! ghosts; particles touching a wall face keep no velocity into it (`Faces::no_penetration`).
-//! Leaves ∇Pⁿ⁺¹ in place of u*.
+//! Leaves ∇Pⁿ⁺¹ in place of u*. With α > 0 the same walk sums the density correction's ∇P_α
+//! (`density_correction`), the two gradients sharing the walk, the distances and the kernel
+//! gradient, each with the bits of a walk of its own.
 
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
@@ -8,7 +10,7 @@ use crate::boundary::faces::{self, Faces};
 use crate::boundary::ghosts::{self, BodyForce};
 use crate::math::lanes::F64s;
 use crate::math::memory::ArraySize;
-use crate::math::reduce::fill_vector_and_update;
+use crate::math::reduce::{fill_vector_and_update, update_vectors};
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Kind, Particles};
 use crate::solver::ppe::Role;
@@ -31,7 +33,9 @@ impl<const D: usize> Default for Corrector<D> {
 
 impl<const D: usize> Corrector<D> {
     /// uⁿ⁺¹ of the fluid particles from `u_star`, which then holds ∇Pⁿ⁺¹; `ghost` is the body
-    /// force the wall ghosts carry where it is not gravity alone (`body_forces`).
+    /// force the wall ghosts carry where it is not gravity alone (`body_forces`). With α > 0,
+    /// `density` is the density correction's P_α and the array its gradient goes into
+    /// (`density_correction`, with mirror walls), summed in the same walk as ∇Pⁿ⁺¹.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -43,6 +47,7 @@ impl<const D: usize> Corrector<D> {
         interfaces: Option<interface::Field<D>>,
         ghost: Option<&[Vec<f64>; D]>,
         u_star: &mut [Vec<f64>; D],
+        density: Option<(&[f64], &mut [Vec<f64>; D])>,
         dt: f64,
     ) -> &[Vec<f64>; D] {
         let n = surface.roles.len();
@@ -51,12 +56,33 @@ impl<const D: usize> Corrector<D> {
         }
         let touch = faces::touching_distance(set.spacing);
         let ghost = set.ghost_force(ghost);
-        fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
-            let grad = pressure_gradient(nb, p, &p.pressure, surface, ghost, interfaces, i);
+        // Eq. (7), and no velocity into a wall face.
+        let correct = |i: usize, u_star: [f64; D], grad: [f64; D]| {
             let rho0 = p.rest_density[i];
             let u = std::array::from_fn(|d| u_star[d] - dt * grad[d] / rho0);
-            (faces.no_penetration(p.position(i), u, touch), grad)
-        });
+            faces.no_penetration(p.position(i), u, touch)
+        };
+        match density {
+            None => fill_vector_and_update(&mut self.velocity, u_star, |i, u_star| {
+                let grad = pressure_gradient(nb, p, &p.pressure, surface, ghost, interfaces, i);
+                (correct(i, u_star, grad), grad)
+            }),
+            Some((density_pressure, density_gradient)) => {
+                for a in density_gradient.iter_mut() {
+                    a.resize(n, 0.0);
+                }
+                let mirror = BodyForce::Uniform([0.0; D]);
+                let fields = [(&p.pressure[..], ghost), (density_pressure, mirror)];
+                update_vectors(
+                    [&mut self.velocity, u_star, density_gradient],
+                    |i, [_, u_star, _]| {
+                        let [grad, grad_density] =
+                            pressure_gradients(nb, p, fields, surface, interfaces, i);
+                        [correct(i, u_star, grad), grad, grad_density]
+                    },
+                );
+            }
+        }
         &self.velocity
     }
 
@@ -99,15 +125,35 @@ pub(super) fn pressure_gradient<const D: usize>(
     interfaces: Option<interface::Field<D>>,
     i: usize,
 ) -> [f64; D] {
+    let [grad] = pressure_gradients(nb, p, [(pressure, ghost_force)], surface, interfaces, i);
+    grad
+}
+
+/// The gradients of `pressure_gradient` of K pressure fields, each with the body force its
+/// wall ghosts carry, in one walk (`sph::gradients`): each with the bits of its own walk.
+fn pressure_gradients<const D: usize, const K: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    fields: [(&[f64], BodyForce<D>); K],
+    surface: &Surface<D>,
+    interfaces: Option<interface::Field<D>>,
+    i: usize,
+) -> [[f64; D]; K] {
     let (role, full) = (surface.roles[i], surface.full_support[i]);
-    let p_ref = pressure_reference(nb, p, pressure, role, full, i);
+    let p_ref =
+        fields.map(|(pressure, _)| F64s::splat(pressure_reference(nb, p, pressure, role, full, i)));
     let l = surface.pressure_corrections.of(i);
-    let (p_ref, side) = (F64s::splat(p_ref), interface::Side::of(p, interfaces, i));
+    let side = interface::Side::of(p, interfaces, i);
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
-    let own = F64s::splat(pressure[i]) - p_ref;
-    sph::gradient(nb, p, l, i, |lanes| match lanes.kind {
-        Kind::Fluid | Kind::Body => side.across(p, interfaces, lanes, lanes.load(pressure) - p_ref),
-        Kind::Wall => own + ghosts::ghost_pressure_difference(p, ghost_force.at(i), i, lanes),
+    let own: [F64s; K] = std::array::from_fn(|k| F64s::splat(fields[k].0[i]) - p_ref[k]);
+    let force = fields.map(|(_, ghost_force)| ghost_force.at(i));
+    sph::gradients(nb, p, l, i, |lanes| match lanes.kind {
+        Kind::Fluid | Kind::Body => std::array::from_fn(|k| {
+            side.across(p, interfaces, lanes, lanes.load(fields[k].0) - p_ref[k])
+        }),
+        Kind::Wall => std::array::from_fn(|k| {
+            own[k] + ghosts::ghost_pressure_difference(p, force[k], i, lanes)
+        }),
     })
 }
 

@@ -13,17 +13,13 @@
 //! converging at about 1% (docs/accuracy.md, "The start-up error of the Taylor–Green vortex").
 //! As a displacement the correction removes the same density error and adds no momentum.
 
-use super::corrector::pressure_gradient;
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
 use crate::boundary::faces::{self, Faces};
-use crate::boundary::ghosts::BodyForce;
 use crate::math::memory::ArraySize;
-use crate::math::reduce::fill_vector;
-use crate::neighbours::Neighbours;
+use crate::math::reduce::update_vectors;
 use crate::particles::{components, Kind, Particles};
 use crate::solver::ppe::Role;
-use crate::sph::interface;
 
 pub const NAME: &str = "density correction";
 
@@ -41,35 +37,30 @@ impl<const D: usize> Default for DensityCorrection<D> {
 }
 
 impl<const D: usize> DensityCorrection<D> {
-    /// δr of the fluid particles from `density_pressure` (P_α) over a step of `dt`; splashes
-    /// stay in place, and no particle touching a wall face moves into it.
-    #[allow(clippy::too_many_arguments)]
+    /// The array the corrector sums ∇P_α into, in its walk for ∇Pⁿ⁺¹ (`Corrector::run`, the
+    /// corrector's gradient with mirror walls): `run` turns it into δr in place.
+    pub fn gradient_slot(&mut self) -> &mut [Vec<f64>; D] {
+        &mut self.displacement
+    }
+
+    /// δr of the fluid particles over a step of `dt` from ∇P_α, which the corrector left in
+    /// the array; splashes stay in place, and no particle touching a wall face moves into it.
     pub fn run(
         &mut self,
-        nb: &Neighbours<D>,
         p: &Particles<D>,
         set: &StepSettings<D>,
         faces: &Faces,
         surface: &Surface<D>,
-        interfaces: Option<interface::Field<D>>,
-        density_pressure: &[f64],
         dt: f64,
     ) -> &mut [Vec<f64>; D] {
-        let n = surface.roles.len();
-        for a in &mut self.displacement {
-            a.resize(n, 0.0);
-        }
         let touch = faces::touching_distance(set.spacing);
-        // The correction's walls are mirror ghosts: no gravity in their differences.
-        let mirror = BodyForce::Uniform([0.0; D]);
-        fill_vector(&mut self.displacement, |i| {
+        update_vectors([&mut self.displacement], |i, [grad]| {
             // Splashes stay in place; a body's particles move rigidly (`rigid_bodies`).
             if surface.roles[i] == Role::Splash || p.kind[i] == Kind::Body {
-                return [0.0; D];
+                return [[0.0; D]];
             }
-            let grad = pressure_gradient(nb, p, density_pressure, surface, mirror, interfaces, i);
             let scale = -dt * dt / p.rest_density[i];
-            faces.no_penetration(p.position(i), grad.map(|g| scale * g), touch)
+            [faces.no_penetration(p.position(i), grad.map(|g| scale * g), touch)]
         });
         &mut self.displacement
     }
@@ -82,7 +73,7 @@ impl<const D: usize> Stage<D> for DensityCorrection<D> {
 
     fn describe(&self, set: &StepSettings<D>) -> String {
         format!(
-            "the density-invariance term of Eq. (6) on the positions only: δr = −(Δt²/ρ0)∇P_α, α = {}, the corrector's gradient with mirror walls (Hu & Adams 2007); no momentum",
+            "the density-invariance term of Eq. (6) on the positions only: δr = −(Δt²/ρ0)∇P_α, α = {}, the corrector's gradient with mirror walls, summed in the corrector's walk (Hu & Adams 2007); no momentum",
             set.alpha
         )
     }

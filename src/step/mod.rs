@@ -406,6 +406,10 @@ impl<const D: usize> Step<D> {
             fill(&mut p.pressure[..nf], |i| cavitation(clip, solved[i]));
             fill(&mut p.free_surface[..nf], |i| surface.roles[i].code());
             laps.lap(pressure_solve::NAME);
+            let density = self.density_correction.as_mut().map(|stage| {
+                let density_pressure = self.pressure_solve.density_pressure();
+                (density_pressure, stage.gradient_slot())
+            });
             self.corrector.run(
                 &nb,
                 p,
@@ -415,6 +419,7 @@ impl<const D: usize> Step<D> {
                 interfaces,
                 ghost,
                 u_star,
+                density,
                 dt,
             );
             let grad_p = &*u_star;
@@ -444,17 +449,7 @@ impl<const D: usize> Step<D> {
             }
             let density_shift = match &mut self.density_correction {
                 Some(stage) => {
-                    let density_pressure = self.pressure_solve.density_pressure();
-                    let shift = stage.run(
-                        &nb,
-                        p,
-                        set,
-                        &self.faces,
-                        &surface,
-                        interfaces,
-                        density_pressure,
-                        dt,
-                    );
+                    let shift = stage.run(p, set, &self.faces, &surface, dt);
                     laps.lap(density_correction::NAME);
                     Some(&*shift)
                 }
