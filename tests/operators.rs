@@ -4,7 +4,7 @@
 use crate::common::Lattice;
 use isph::neighbours::Neighbours;
 use isph::particles::Kind;
-use isph::sph::{field_laplacian, fitted_value, laplacian_coefficient};
+use isph::sph::{field_laplacian, fitted_value, fitted_values, laplacian_coefficient};
 
 /// −Σ_j a_ij (φ_i − φ_j) at the lattice centre for φ = |x|², whose Laplacian is 2D.
 fn laplacian_of_quadratic<const D: usize>(n: i64, h_over_dx: f64) -> f64 {
@@ -67,6 +67,11 @@ fn fitted_value_is_exact_for_linear_fields_and_blind_to_its_own<const D: usize>(
             (fitted - exact).abs() < 1e-9 * exact.abs(),
             "{D}D: {fitted} vs {exact}"
         );
+        // Two fields fitted in one walk have the bits of two fits.
+        let other: Vec<f64> = pressure.iter().map(|x| 0.5 * x * x).collect();
+        let both = fitted_values(&nb, p, [&pressure, &other], i).unwrap();
+        let alone = [&pressure, &other].map(|v| fitted_value(&nb, p, v, i).unwrap());
+        assert_eq!(both.map(f64::to_bits), alone.map(f64::to_bits));
         pressure[i] += 500.0;
         let blind = fitted_value(&nb, p, &pressure, i).unwrap();
         assert!(

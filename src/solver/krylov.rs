@@ -58,7 +58,8 @@ pub fn inverse_diagonal(a: &impl LinearOperator, inv: &mut Vec<f64>) -> Result<(
 
 #[derive(Clone, Copy, Debug)]
 pub struct SolverParams {
-    /// Stop when ‖b − Ax‖ ≤ tolerance ‖b‖.
+    /// Stop when the residual ‖b − Ax‖, as BiCGSTAB updates it recursively, is at most
+    /// tolerance ‖b‖.
     pub tolerance: f64,
     pub max_iterations: usize,
 }

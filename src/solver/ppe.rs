@@ -148,7 +148,8 @@ pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &m
 
 /// The per-row vector of the operator ĉ_i = L'_iᵀ c_i of the consistent Laplacian (see
 /// `LaplacianTruncation`), with L'_i the correction of the pressure gradient
-/// (`sph::Moments::m_neumann`), for interior rows; zero for the others, which couple nothing.
+/// (`sph::Moments::m_neumann`; None, the identity, where the kernel correction is off), for
+/// interior rows; zero for the others, which couple nothing.
 /// Deep inside the fluid c_i measures the disorder of the particles, and the row is corrected
 /// all the same: left uncorrected, those rows let still water go unstable within seconds, and
 /// with the correction the tank stays at rest (docs/stabilisation.md, "The free-surface and

@@ -11,7 +11,7 @@
 //! f = ½ a stable layering of a fluid at half the water's density over water is set in motion,
 //! with this f it stays at rest (`tests/hydrostatic.rs`,
 //! `a_fluid_at_half_the_density_of_water_keeps_its_hydrostatic_pressure`; docs/scene-format.md,
-//! "`[[fluid]]`"; `ppe::laplacian_correction` and `PressureOperator::interior_weights` for the
+//! "`[[fluid]]`"; `ppe::LaplacianTruncation` and `PressureOperator::interior_weights` for the
 //! other half of the weighting). f comes from each particle's distance to the interface d_i
 //! (`Interfaces::distance`) and its normal across it (`other_fluid_share`): `pair_weight`.
 

@@ -436,22 +436,38 @@ pub fn fitted_value<const D: usize>(
     values: &[f64],
     i: usize,
 ) -> Option<f64> {
+    fitted_values(nb, p, [values], i).map(|[value]| value)
+}
+
+/// `fitted_value` of K fields in one walk, the neighbours' weights and positions shared: each
+/// value with the bits of its own fit. None where the neighbours fix no linear function (the
+/// same for every field).
+pub fn fitted_values<const D: usize, const K: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    values: [&[f64]; K],
+    i: usize,
+) -> Option<[f64; K]> {
     let own_fluid = F64s::splat(p.rest_density[i]);
     // Weighted sums of 1, d = x_j − x_i, φ, d dᵀ and d φ.
-    let (mut w_sum, mut phi_sum) = (Sum::ZERO, Sum::ZERO);
+    let (mut w_sum, mut phi_sum) = (Sum::ZERO, [Sum::ZERO; K]);
     let mut d_sum = [Sum::ZERO; D];
     let mut dd_sum = [[Sum::ZERO; D]; D];
-    let mut dphi_sum = [Sum::ZERO; D];
+    let mut dphi_sum = [[Sum::ZERO; D]; K];
     nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
         let same = l.load(&p.rest_density).simd_eq(own_fluid);
         let w = nb.kernel.w_lanes(l.r) & l.mask & same;
-        let phi = l.load(values) & l.mask;
+        let phi = values.map(|values| l.load(values) & l.mask);
         w_sum += w;
-        phi_sum = phi_sum.mul_add(w, phi);
+        for k in 0..K {
+            phi_sum[k] = phi_sum[k].mul_add(w, phi[k]);
+        }
         for a in 0..D {
             let wd = -w * l.rij[a];
             d_sum[a] += wd;
-            dphi_sum[a] = dphi_sum[a].mul_add(wd, phi);
+            for k in 0..K {
+                dphi_sum[k][a] = dphi_sum[k][a].mul_add(wd, phi[k]);
+            }
             for b in a..D {
                 dd_sum[a][b] = dd_sum[a][b].mul_add(wd, -l.rij[b]);
             }
@@ -459,19 +475,22 @@ pub fn fitted_value<const D: usize>(
     });
     let w = w_sum.total();
     let d_mean = d_sum.map(|x| x.total() / w);
-    let phi_mean = phi_sum.total() / w;
     let covariance: [[f64; D]; D] = std::array::from_fn(|a| {
         std::array::from_fn(|b| dd_sum[a.min(b)][a.max(b)].total() - w * d_mean[a] * d_mean[b])
     });
-    let cross: [f64; D] = std::array::from_fn(|a| dphi_sum[a].total() - w * d_mean[a] * phi_mean);
     let spread = (0..D).map(|a| covariance[a][a]).sum::<f64>() / D as f64;
     let (inverse, det) = invert(covariance)?;
     let spans = w > 0.0 && det > MIN_FIT_ISOTROPY * spread.powi(D as i32);
     if !spans {
         return None;
     }
-    let slope = apply_correction(&Some(inverse), cross);
-    Some(phi_mean - (0..D).map(|a| slope[a] * d_mean[a]).sum::<f64>())
+    Some(std::array::from_fn(|k| {
+        let phi_mean = phi_sum[k].total() / w;
+        let cross: [f64; D] =
+            std::array::from_fn(|a| dphi_sum[k][a].total() - w * d_mean[a] * phi_mean);
+        let slope = apply_correction(&Some(inverse), cross);
+        phi_mean - (0..D).map(|a| slope[a] * d_mean[a]).sum::<f64>()
+    }))
 }
 
 /// Corrected gradient of a scalar field, ∇φ_i = L_i Σ_j V_j (φ_j − φ_i) ∇W_ij, Eq. (20) with

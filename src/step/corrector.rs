@@ -140,8 +140,8 @@ fn pressure_gradients<const D: usize, const K: usize>(
     i: usize,
 ) -> [[f64; D]; K] {
     let (role, full) = (surface.roles[i], surface.full_support[i]);
-    let p_ref =
-        fields.map(|(pressure, _)| F64s::splat(pressure_reference(nb, p, pressure, role, full, i)));
+    let p_ref = pressure_references(nb, p, fields.map(|(pressure, _)| pressure), role, full, i)
+        .map(F64s::splat);
     let l = surface.pressure_corrections.of(i);
     let side = interface::Side::of(p, interfaces, i);
     // A wall ghost mirrors P_i itself: P_b − p_ref = (P_i − p_ref) + (P_b − P_i).
@@ -157,10 +157,10 @@ fn pressure_gradients<const D: usize, const K: usize>(
     })
 }
 
-/// The pressure (of `pressure`) at fluid particle i that its pressure gradient takes the differences
-/// P_j − P_i from: P_i itself, but for an unknown of the PPE with the free surface in its
+/// The pressures (of each of the K fields `pressures`) at fluid particle i that its pressure
+/// gradients take the differences P_j − P_i from, the K fits in one walk: P_i itself, but for an unknown of the PPE with the free surface in its
 /// kernel support (`role` Interior, not `full_support`) the value P̃_i of the linear function
-/// fitted to its fluid neighbours' pressures (`sph::fitted_value`; P_i where they fix none).
+/// fitted to its fluid neighbours' pressures (`sph::fitted_values`; P_i where they fix none).
 /// Both are exact for a linear field. Where the surface truncates the support, the difference
 /// form carries the term −P_i L'_i Σ_j V_j ∇W_ij, which points out of the fluid: a particle
 /// whose pressure dips below its neighbours' is pushed towards the surface, and the projection
@@ -169,17 +169,18 @@ fn pressure_gradients<const D: usize, const K: usize>(
 /// under the surface (its largest eigenvalue at rest, by power iteration, exceeds 1), and the
 /// tank sloshes; with P̃_i the largest eigenvalue is 1, the divergence-free fields'
 /// (docs/stabilisation.md, "The pressure reference near the free surface").
-fn pressure_reference<const D: usize>(
+fn pressure_references<const D: usize, const K: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    pressure: &[f64],
+    pressures: [&[f64]; K],
     role: Role,
     full_support: bool,
     i: usize,
-) -> f64 {
+) -> [f64; K] {
+    let own = pressures.map(|pressure| pressure[i]);
     if role == Role::Interior && !full_support {
-        sph::fitted_value(nb, p, pressure, i).unwrap_or(pressure[i])
+        sph::fitted_values(nb, p, pressures, i).unwrap_or(own)
     } else {
-        pressure[i]
+        own
     }
 }

@@ -117,7 +117,13 @@ impl<const D: usize> FreeSurface<D> {
                         i,
                     )
                 };
-                *row_vector = ppe::row_vector(*role, &truncation, &l_pressure);
+                // ĉ_i = L'_iᵀ c_i with the kernel correction, c_i without it.
+                let l_row = if corrections.is_some() {
+                    &l_pressure
+                } else {
+                    &None
+                };
+                *row_vector = ppe::row_vector(*role, &truncation, l_row);
                 if let Some(normal) = normal {
                     *normal = support.normal;
                 }
@@ -193,5 +199,115 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
             arrays.push(ArraySize::of("surface normal", normals));
         }
         arrays
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::kernel::{Kernel, KernelKind};
+    use crate::neighbours::cell_list::CellList;
+    use crate::particles::{Kind, NewParticle};
+    use crate::scene::GhostPressure;
+    use crate::solver::krylov::SolverParams;
+
+    /// ĉ_i of interior row i as the PPE needs it: L'_iᵀ c_i with the kernel correction, c_i
+    /// without it (its pressure gradient is then uncorrected, and the row must match it).
+    fn expected_row_vector(
+        nb: &Neighbours<2>,
+        p: &Particles<2>,
+        i: usize,
+        corrected: bool,
+    ) -> [f64; 2] {
+        let mut truncation = LaplacianTruncation::new(p, false, i);
+        let mo =
+            sph::support_moments_and(nb, p, i, |l, followed| truncation.add(nb, p, l, followed));
+        let l = if corrected {
+            sph::gradient_correction(
+                mo.m_neumann,
+                sph::min_correction_determinant::<2>(KernelKind::Quintic, 1.2),
+            )
+        } else {
+            None
+        };
+        ppe::row_vector(Role::Interior, &truncation, &l)
+    }
+
+    #[test]
+    fn the_row_vectors_take_the_pressure_correction_only_where_the_kernel_correction_is_on() {
+        // Water 16 × 10 spacings over four rows of floor, its free surface at the top.
+        let (dx, h_over_dx) = (0.01, 1.2);
+        let mut p = Particles::<2>::default();
+        for ix in 0..16 {
+            for iy in 0..14 {
+                let wall = iy < 4;
+                p.push(NewParticle {
+                    pos: [(ix as f64 + 0.5) * dx, (iy as f64 - 3.5) * dx],
+                    kind: if wall { Kind::Wall } else { Kind::Fluid },
+                    normal: if wall { [0.0, 1.0] } else { [0.0, 0.0] },
+                    fluid: 0,
+                    mass: 1000.0 * dx * dx,
+                    rest_density: 1000.0,
+                    viscosity: 1e-6,
+                });
+            }
+        }
+        let kernel = Kernel::<2>::new(KernelKind::Quintic, dx, h_over_dx);
+        let mut grid = CellList::new([-0.1, -0.1], [0.3, 0.3], kernel.support(), [false; 2]);
+        let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
+        grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
+        p.permute(&order, &mut scratch);
+        let nb = Neighbours::new(&grid, &p.pos, kernel);
+        let nf = grid.range_of(Kind::Fluid).end;
+        let density: Vec<f64> = (0..nf).map(|i| sph::density(&nb, &p, i)).collect();
+        p.density[..nf].copy_from_slice(&density);
+        let mut corrected_rows = 0;
+        for corrected in [false, true] {
+            let effects = Effects {
+                shifting: None,
+                les: None,
+                kernel_correction: corrected,
+            };
+            let set = StepSettings {
+                gravity: [0.0, -9.81],
+                ghost_pressure: GhostPressure::Hydrostatic,
+                spacing: dx,
+                alpha: 0.3,
+                solver: SolverParams {
+                    tolerance: 1e-6,
+                    max_iterations: 100,
+                },
+                effects,
+                confined: false,
+                spray_density: crate::sph::free_surface::spray_density::<2>(
+                    KernelKind::Quintic,
+                    h_over_dx,
+                ),
+                min_correction_determinant: sph::min_correction_determinant::<2>(
+                    KernelKind::Quintic,
+                    h_over_dx,
+                ),
+                cfl: 0.4,
+                max_viscosity: 1e-6,
+            };
+            let mut stage = FreeSurface::new(&effects);
+            stage.run(&nb, &p, &set, false, nf);
+            let s = stage.output();
+            for i in (0..nf).filter(|&i| s.roles[i] == Role::Interior) {
+                let expected = expected_row_vector(&nb, &p, i, corrected);
+                assert_eq!(
+                    s.row_vectors[i], expected,
+                    "row {i}, kernel correction {corrected}"
+                );
+                corrected_rows +=
+                    usize::from(corrected && expected != expected_row_vector(&nb, &p, i, false));
+            }
+        }
+        // The surface's rows are where L'_i differs from the identity: the test compares
+        // different vectors there.
+        assert!(
+            corrected_rows > 10,
+            "{corrected_rows} rows whose L' moves ĉ"
+        );
     }
 }

@@ -4,6 +4,9 @@
 //! it reads from earlier stages as arguments, so the data flow is the signatures. The stages of
 //! the effects a scene turns off (`scene::Effects`) are `None` and cost nothing: no call, no
 //! array. `Step::stages` lists the stages that run, in order, for `isph plan` and the timings.
+//! One stage fills another's array: the corrector sums the density correction's ∇P_α into it
+//! (`DensityCorrection::gradient_slot`) in its walk for ∇Pⁿ⁺¹, and the density correction turns
+//! it into its displacement.
 //!
 //! The fluid particles come first in the sorted order (`cell_list`), and every stage's array
 //! but the sort's holds the fluid particles only: the walls hold no unknown and need none.
