@@ -376,11 +376,11 @@ fn divergence_rate_in_drift<const D: usize>(grad_u: &[[f64; D]; D]) -> f64 {
 fn volume_mass<const D: usize>(
     p: &Particles<D>,
     interfaces: bool,
-    row: &Side<D>,
+    rest_density_i: F64s,
     l: &Lanes<D>,
 ) -> F64s {
     if interfaces {
-        mass_at_density(p, row.rest_density, l)
+        mass_at_density(p, rest_density_i, l)
     } else {
         l.load(&p.mass)
     }
@@ -404,8 +404,8 @@ pub struct LaplacianTruncation<const D: usize> {
     c: [Sum; D],
     /// 2/ρ0_i.
     scale: F64s,
-    /// ρ0_i, where the fluids differ in rest density (None: one density).
-    rest_density: Option<F64s>,
+    rest_density: F64s,
+    fluids_differ: bool,
 }
 
 impl<const D: usize> LaplacianTruncation<D> {
@@ -415,7 +415,8 @@ impl<const D: usize> LaplacianTruncation<D> {
         Self {
             c: [Sum::ZERO; D],
             scale: F64s::splat(2.0 / rest_density),
-            rest_density: fluids_differ.then(|| F64s::splat(rest_density)),
+            rest_density: F64s::splat(rest_density),
+            fluids_differ,
         }
     }
 
@@ -433,10 +434,7 @@ impl<const D: usize> LaplacianTruncation<D> {
         // across an interface the pairs are weighted by design (`interior_weights`), and taken
         // for truncation that weighting would be undone, leaving one fluid's pressure gradient
         // through both.
-        let mass = match self.rest_density {
-            Some(rest_density) => mass_at_density(p, rest_density, l),
-            None => l.load(&p.mass),
-        };
+        let mass = volume_mass(p, self.fluids_differ, self.rest_density, l);
         let cl = (self.scale * mass * laplacian_factor) & l.mask;
         for d in 0..D {
             self.c[d] = self.c[d].mul_add(cl, followed[d]);
@@ -491,7 +489,12 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// its interface meets a side wall).
     #[inline(always)]
     fn interior_weights(&self, row: &Row<D>, l: &Lanes<D>, volume: F64s) -> F64s {
-        let mass = volume_mass(self.p, self.interfaces.is_some(), &row.density, l);
+        let mass = volume_mass(
+            self.p,
+            self.interfaces.is_some(),
+            row.density.rest_density,
+            l,
+        );
         // a_ij − V_j F ĉ_i·r_ij = k ((−2 m_j/ρ_i) r² − V_j (r² + η²) ĉ_i·r_ij), with
         // F = k (r² + η²) and the Laplacian factor k r² (`RadialTerms`).
         let radial = self.nb.radial_terms_lanes(l.r);

@@ -205,9 +205,7 @@ impl<const D: usize> Side<D> {
     }
 
     /// `value`, a term of the pairs of i with the lanes `l`, weighted by ρ0_i/ρ̄_ij
-    /// (`pair_weight`) where the fluids differ in rest density (`field`); unchanged where they
-    /// share one and for wall lanes (a wall ghost is one of i's own fluid). The length across
-    /// the interface is L = ½ (n_j − n_i)·r_ij, the segment projected on the two normals.
+    /// (`weight`).
     #[inline(always)]
     pub fn across(
         &self,
@@ -216,27 +214,35 @@ impl<const D: usize> Side<D> {
         l: &Lanes<D>,
         value: F64s,
     ) -> F64s {
-        match (field, l.kind) {
-            (Some(field), Kind::Fluid) => {
-                let rest_density = l.load(&p.rest_density);
-                if rest_density.simd_eq(self.rest_density).all() {
-                    // Within one fluid the weight is exactly 1.
-                    return value;
-                }
-                let distance_j = l.load(field.distance);
-                let length = (0..D).fold(F64s::ZERO, |s, d| {
-                    (l.load(&field.normal[d]) - self.normal[d]).mul_add(l.rij[d], s)
-                }) * F64s::splat(0.5);
-                value
-                    * pair_weight(
-                        self.rest_density,
-                        rest_density,
-                        self.distance,
-                        distance_j,
-                        length,
-                    )
-            }
-            _ => value,
+        match self.weight(p, field, l) {
+            Some(weight) => value * weight,
+            None => value,
         }
+    }
+
+    /// The weight ρ0_i/ρ̄_ij (`pair_weight`) of the pairs of i with the lanes `l` where the
+    /// fluids differ in rest density (`field`); None, a weight of exactly 1, where they share
+    /// one and for wall lanes (a wall ghost is one of i's own fluid). The length across the
+    /// interface is L = ½ (n_j − n_i)·r_ij, the segment projected on the two normals.
+    #[inline(always)]
+    pub fn weight(&self, p: &Particles<D>, field: Option<Field<D>>, l: &Lanes<D>) -> Option<F64s> {
+        let (Some(field), Kind::Fluid) = (field, l.kind) else {
+            return None;
+        };
+        let rest_density = l.load(&p.rest_density);
+        if rest_density.simd_eq(self.rest_density).all() {
+            return None;
+        }
+        let distance_j = l.load(field.distance);
+        let length = (0..D).fold(F64s::ZERO, |s, d| {
+            (l.load(&field.normal[d]) - self.normal[d]).mul_add(l.rij[d], s)
+        }) * F64s::splat(0.5);
+        Some(pair_weight(
+            self.rest_density,
+            rest_density,
+            self.distance,
+            distance_j,
+            length,
+        ))
     }
 }

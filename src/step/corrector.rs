@@ -148,9 +148,14 @@ fn pressure_gradients<const D: usize, const K: usize>(
     let own: [F64s; K] = std::array::from_fn(|k| F64s::splat(fields[k].0[i]) - p_ref[k]);
     let force = fields.map(|(_, ghost_force)| ghost_force.at(i));
     sph::gradients(nb, p, l, i, |lanes| match lanes.kind {
-        Kind::Fluid | Kind::Body => std::array::from_fn(|k| {
-            side.across(p, interfaces, lanes, lanes.load(fields[k].0) - p_ref[k])
-        }),
+        Kind::Fluid | Kind::Body => {
+            // One weight across an interface for the K fields (`Side::across`).
+            let weight = side.weight(p, interfaces, lanes);
+            std::array::from_fn(|k| {
+                let difference = lanes.load(fields[k].0) - p_ref[k];
+                weight.map_or(difference, |w| difference * w)
+            })
+        }
         Kind::Wall => std::array::from_fn(|k| {
             own[k] + ghosts::ghost_pressure_difference(p, force[k], i, lanes)
         }),
