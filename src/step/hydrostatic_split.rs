@@ -96,7 +96,7 @@ fn surface_excess<const D: usize>(
         if lanes.kind == Kind::Wall {
             return F64s::ZERO;
         }
-        let w = side.across(p, Some(interfaces), lanes, F64s::ONE);
+        let w = side.weight(p, Some(interfaces), lanes).unwrap_or(F64s::ONE);
         let body_j = lanes.load(body);
         // ρ0_f f_f·(r_j − r_i) = −ρ0_f f_f·r_ij, and whether the pair straddles a body's surface.
         let (fluid_density, other) = if body_i {
