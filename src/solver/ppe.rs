@@ -17,7 +17,7 @@
 //! first in the sorted order).
 
 use crate::boundary::ghosts::{ghost_pressure_difference, ghost_velocity, BodyForce};
-use crate::math::lanes::{F64s, Sum, LANES};
+use crate::math::lanes::{F64s, Sum};
 use crate::math::reduce::{fill, fill_pair};
 use crate::neighbours::Lanes;
 use crate::neighbours::Neighbours;
@@ -28,6 +28,7 @@ use crate::sph::free_surface::Support;
 use crate::sph::interface::{Field, Side};
 use crate::sph::{mass_at_density, velocity_gradient, Correction, Corrections};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The role of a particle in the pressure solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -130,19 +131,30 @@ pub fn highest<const D: usize>(
 
 /// Marks fluid particles whose kernel support holds no free-surface particle: there the
 /// summation density measures compression, not the truncation of the kernel at the surface.
+/// The free-surface particles (a small part of the fluid) mark the fluid they reach, instead of
+/// every interior row looking for one: the same pairs, as r_ji = −r_ij to the bit. Across a
+/// periodic boundary the two images of a pair round apart, so there a pair at the very edge of
+/// the support may be found from one side only.
 pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &mut Vec<bool>) {
+    let reached: Vec<AtomicBool> = roles.iter().map(|_| AtomicBool::new(false)).collect();
+    roles
+        .par_iter()
+        .enumerate()
+        .filter(|(_, role)| role.is_free())
+        .for_each(|(s, _)| {
+            nb.for_each_lanes_of(s, &[Kind::Fluid], |l| {
+                // The neighbours among the lanes (fluid rows: a fluid range holds fluid and
+                // body particles).
+                let mut lanes = l.mask.to_bitmask();
+                while lanes != 0 {
+                    reached[l.j0 + lanes.trailing_zeros() as usize].store(true, Ordering::Relaxed);
+                    lanes &= lanes - 1;
+                }
+            });
+        });
     full.resize(roles.len(), false);
     fill(full, |i| {
-        if roles[i] != Role::Interior {
-            return false;
-        }
-        let mut any_free = false;
-        nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-            for k in 0..LANES {
-                any_free |= l.active(k) & roles.get(l.j0 + k).is_some_and(|r| r.is_free());
-            }
-        });
-        !any_free
+        roles[i] == Role::Interior && !reached[i].load(Ordering::Relaxed)
     });
 }
 
