@@ -98,7 +98,7 @@ fn check<const D: usize>(n: i64) {
     let row_vectors: Vec<[f64; D]> = (0..nf)
         .map(|i| {
             let mut truncation = LaplacianTruncation::new(&p, false, i);
-            sph::support_moments_and(&nb, &p, i, |l, followed| {
+            sph::support_moments_and(&nb, &p, i, |l, _, followed| {
                 truncation.add(&nb, &p, l, followed)
             });
             ppe::row_vector(Role::Interior, &truncation, &None)

@@ -16,9 +16,7 @@
 //! Cs and whether the wall function applies are the scene's `[effects.les]` (`LesSettings`).
 
 use crate::boundary::ghosts::Face;
-use crate::neighbours::Neighbours;
 use crate::particles::Particles;
-use crate::sph::{fluid_velocity, velocity_gradient, Correction};
 
 /// von Kármán constant κ.
 const KARMAN: f64 = 0.41;
@@ -27,19 +25,9 @@ const LOG_LAW_B: f64 = 5.2;
 /// y⁺ below which the first particle lies in the viscous sublayer (u⁺ = y⁺).
 const SUBLAYER_Y_PLUS: f64 = 11.0;
 
-/// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S|, |S| = (2 S_ab S_ab)^½, S the strain rate of
-/// the corrected velocity gradient (Eq. 3–4), Δ the particle spacing.
-pub fn eddy_viscosity<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    l: &Correction<D>,
-    cs: f64,
-    spacing: f64,
-    i: usize,
-) -> f64 {
-    let cs_delta = cs * spacing;
-    let u_i = p.velocity(i);
-    let grad = velocity_gradient(nb, p, l, u_i, |l| fluid_velocity(p, u_i, l), i);
+/// |S| = (2 S_ab S_ab)^½ of the velocity gradient `grad`, S its symmetric part, the strain
+/// rate (Eq. 4).
+pub fn strain_rate<const D: usize>(grad: [[f64; D]; D]) -> f64 {
     let mut ss = 0.0;
     for a in 0..D {
         for b in 0..D {
@@ -47,7 +35,15 @@ pub fn eddy_viscosity<const D: usize>(
             ss += s * s;
         }
     }
-    cs_delta * cs_delta * (2.0 * ss).sqrt()
+    (2.0 * ss).sqrt()
+}
+
+/// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S| (Eq. 3), with `strain_rate` |S| of the
+/// corrected velocity gradient (the walls free-slip ghosts, `sph::fluid_velocity`) and Δ the
+/// particle spacing.
+pub fn eddy_viscosity(strain_rate: f64, cs: f64, spacing: f64) -> f64 {
+    let cs_delta = cs * spacing;
+    cs_delta * cs_delta * strain_rate
 }
 
 /// The acceleration of fluid particle i by the turbulent part of the wall shear stress, with

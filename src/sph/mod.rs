@@ -158,19 +158,52 @@ pub fn velocity_gradient_and<const D: usize>(
     i: usize,
     mut also: impl FnMut(&Lanes<D>, F64s),
 ) -> [[f64; D]; D] {
-    let mut g = [[Sum::ZERO; D]; D];
+    let mut g = VelocityGradientSum::new(u_i);
     nb.for_each_lanes(i, |lanes| {
         let vf = volume_gradient_factor(nb, p, lanes);
         also(lanes, vf);
-        let u_j = u(lanes);
+        g.add(lanes, vf, u(lanes));
+    });
+    corrected_gradient(l, g.total())
+}
+
+/// The sum Σ_j V_j (u_j − u_i) ⊗ ∇W_ij of a velocity gradient (`velocity_gradient`) before its
+/// correction, chunk by chunk: for a walk that sums it beside others (the eddy viscosity's, in
+/// the free surface's walk of the support moments).
+pub struct VelocityGradientSum<const D: usize> {
+    /// [b][a]: Σ_j V_j (u_j − u_i)_a ∂_b W_ij.
+    g: [[Sum; D]; D],
+    u_i: [F64s; D],
+}
+
+impl<const D: usize> VelocityGradientSum<D> {
+    /// The sum at a particle of velocity `u_i`.
+    pub fn new(u_i: [f64; D]) -> Self {
+        Self {
+            g: [[Sum::ZERO; D]; D],
+            u_i: u_i.map(F64s::splat),
+        }
+    }
+
+    /// Adds the lanes `l` with their factor V_j ∇W_ij/r_ij `vf` and velocities `u_j`.
+    #[inline(always)]
+    pub fn add(&mut self, l: &Lanes<D>, vf: F64s, u_j: [F64s; D]) {
         for a in 0..D {
-            let du = vf * (u_j[a] - F64s::splat(u_i[a]));
+            let du = vf * (u_j[a] - self.u_i[a]);
             for b in 0..D {
-                g[b][a] = g[b][a].mul_add(du, lanes.rij[b]);
+                self.g[b][a] = self.g[b][a].mul_add(du, l.rij[b]);
             }
         }
-    });
-    let g = g.map(|row| row.map(|x| x.total()));
+    }
+
+    /// The uncorrected gradient, [b][a] = ∂u_a/∂x_b.
+    pub fn total(&self) -> [[f64; D]; D] {
+        self.g.map(|row| row.map(|x| x.total()))
+    }
+}
+
+/// The gradient `g` ([b][a] = ∂u_a/∂x_b) corrected by L_i (Eq. 24–25; None: as it is).
+pub fn corrected_gradient<const D: usize>(l: &Correction<D>, g: [[f64; D]; D]) -> [[f64; D]; D] {
     std::array::from_fn(|b| {
         std::array::from_fn(|a| match l {
             Some(l) => (0..D).map(|c| l[b][c] * g[c][a]).sum(),
@@ -270,18 +303,19 @@ pub fn support_moments<const D: usize>(
     p: &Particles<D>,
     i: usize,
 ) -> Moments<D> {
-    support_moments_and(nb, p, i, |_, _| {})
+    support_moments_and(nb, p, i, |_, _, _| {})
 }
 
 /// The support moments of particle i, handing each chunk of neighbours `l` on to `also` with
-/// the part of r_ij a pressure field follows there (`Moments::m_neumann`): a sum over the same
-/// support in the same walk (the PPE's row vector, `ppe::LaplacianTruncation`).
+/// its V_j ∇W_ij factor (`volume_gradient_factor`) and the part of r_ij a pressure field follows
+/// there (`Moments::m_neumann`): sums over the same support in the same walk (the PPE's row
+/// vector, `ppe::LaplacianTruncation`; the eddy viscosity's velocity gradient).
 #[inline(always)]
 pub fn support_moments_and<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     i: usize,
-    mut also: impl FnMut(&Lanes<D>, &[F64s; D]),
+    mut also: impl FnMut(&Lanes<D>, F64s, &[F64s; D]),
 ) -> Moments<D> {
     let (mut m, mut m_neumann) = ([[Sum::ZERO; D]; D], [[Sum::ZERO; D]; D]);
     let (mut grad_c, mut fluid_neighbours) = ([Sum::ZERO; D], 0);
@@ -296,7 +330,7 @@ pub fn support_moments_and<const D: usize>(
             }
             Kind::Wall => behind_walls(p, l, l.rij),
         };
-        also(l, &followed);
+        also(l, vf, &followed);
         for a in 0..D {
             let v = vf * l.rij[a];
             grad_c[a] += v;

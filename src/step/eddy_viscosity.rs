@@ -4,8 +4,6 @@ use super::{Stage, StepSettings};
 use crate::effects::les;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill;
-use crate::neighbours::Neighbours;
-use crate::particles::Particles;
 use crate::scene::LesSettings;
 use crate::sph::Corrections;
 
@@ -26,18 +24,24 @@ impl EddyViscosity {
     }
 
     /// ν_t of the `nf` fluid particles, from the velocity gradient corrected by `corrections`.
+    /// ν_t of each fluid particle from its strain rates `strain_rates` ([uncorrected,
+    /// corrected], the free surface's walk: `FreeSurface::strain_rates`), the corrected one
+    /// where `corrections` corrects the particle's gradients.
     pub fn run<const D: usize>(
         &mut self,
-        nb: &Neighbours<D>,
-        p: &Particles<D>,
+        strain_rates: &[[f64; 2]],
         corrections: Corrections<D>,
         spacing: f64,
-        nf: usize,
     ) -> &[f64] {
-        self.eddy.resize(nf, 0.0);
+        self.eddy.resize(strain_rates.len(), 0.0);
         let cs = self.settings.cs;
         fill(&mut self.eddy, |i| {
-            les::eddy_viscosity(nb, p, corrections.of(i), cs, spacing, i)
+            let [plain, corrected] = strain_rates[i];
+            let rate = match corrections.of(i) {
+                Some(_) => corrected,
+                None => plain,
+            };
+            les::eddy_viscosity(rate, cs, spacing)
         });
         &self.eddy
     }
@@ -50,7 +54,7 @@ impl<const D: usize> Stage<D> for EddyViscosity {
 
     fn describe(&self, _: &StepSettings<D>) -> String {
         format!(
-            "Smagorinsky ν_t = (Cs Δ)² |S| (Eq. 3–4), Cs = {}, Δ = dx, walls as free-slip ghosts",
+            "Smagorinsky ν_t = (Cs Δ)² |S| (Eq. 3–4), Cs = {}, Δ = dx, walls as free-slip ghosts; the strain rate from the free surface's walk",
             self.settings.cs
         )
     }

@@ -2,16 +2,20 @@
 //! surface and the role of each fluid particle in the PPE (`ppe::role`), the particles with no
 //! free surface in reach, and what the same walk gives at no extra pass: the pressure
 //! gradient's L'_i of Eq. (25) with the kernel correction, the surface normal with shifting,
-//! and the PPE's row vectors ĉ_i (`ppe::row_vector`).
+//! the PPE's row vectors ĉ_i (`ppe::row_vector`), and with LES the strain rate of the velocity
+//! gradient (`sph::VelocityGradientSum`: the same neighbours with the same V_j ∇W_ij factor as
+//! the moments) both as summed and corrected by L_i = M_i⁻¹ of the same moments, for the eddy
+//! viscosity to take the one the kernel correction asks for once the free surface is known.
 
 use super::{Stage, StepSettings};
+use crate::effects::les;
 use crate::math::memory::ArraySize;
 use crate::neighbours::Neighbours;
 use crate::particles::Particles;
 use crate::scene::Effects;
 use crate::solver::ppe::{self, LaplacianTruncation, Role};
 use crate::sph::free_surface::Support;
-use crate::sph::{self, Correction, Corrections};
+use crate::sph::{self, Correction, Corrections, VelocityGradientSum};
 use rayon::iter::Either;
 use rayon::prelude::*;
 
@@ -32,6 +36,9 @@ pub struct FreeSurface<const D: usize> {
     surface_normal: Option<Vec<[f64; D]>>,
     /// The PPE's row vectors ĉ_i (`ppe::row_vector`).
     row_vectors: Vec<[f64; D]>,
+    /// |S| of each fluid particle's velocity gradient (`les::strain_rate`), the walls free-slip
+    /// ghosts: [uncorrected, corrected by L_i = M_i⁻¹] (with LES).
+    strain_rates: Option<Vec<[f64; 2]>>,
 }
 
 /// What the stage found, for the stages after it.
@@ -57,6 +64,7 @@ impl<const D: usize> FreeSurface<D> {
             pressure_corrections: effects.kernel_correction.then(Vec::new),
             surface_normal: effects.shifting.map(|_| Vec::new()),
             row_vectors: Vec::new(),
+            strain_rates: effects.les.map(|_| Vec::new()),
         }
     }
 
@@ -87,50 +95,74 @@ impl<const D: usize> FreeSurface<D> {
             }
             None => Either::Right((0..n).into_par_iter().map(|_| None)),
         };
+        let strain_rates = match &mut self.strain_rates {
+            Some(rates) => {
+                rates.resize(n, [0.0; 2]);
+                Either::Left(rates.par_iter_mut().map(Some))
+            }
+            None => Either::Right((0..n).into_par_iter().map(|_| None)),
+        };
         self.roles
             .par_iter_mut()
             .zip(&mut self.row_vectors)
             .zip(normals)
             .zip(corrections)
+            .zip(strain_rates)
             .enumerate()
-            .for_each(|(i, (((role, row_vector), normal), corrections))| {
-                let mut truncation = LaplacianTruncation::new(p, fluids_differ, i);
-                let mo = sph::support_moments_and(nb, p, i, |l, followed| {
-                    truncation.add(nb, p, l, followed)
-                });
-                let l_pressure =
-                    sph::gradient_correction(mo.m_neumann, set.min_correction_determinant);
-                let support = Support::new(&mo.m, mo.grad_c);
-                // Fluid that fills its container has no free surface: every row is interior
-                // (a disordered patch of a periodic flow can look like a surface to the
-                // detection).
-                *role = if set.confined {
-                    Role::Interior
-                } else {
-                    ppe::role(
-                        nb,
-                        p,
-                        &support,
-                        mo.fluid_neighbours,
-                        l_pressure.is_some(),
-                        set.spray_density,
-                        i,
-                    )
-                };
-                // ĉ_i = L'_iᵀ c_i with the kernel correction, c_i without it.
-                let l_row = if corrections.is_some() {
-                    &l_pressure
-                } else {
-                    &None
-                };
-                *row_vector = ppe::row_vector(*role, &truncation, l_row);
-                if let Some(normal) = normal {
-                    *normal = support.normal;
-                }
-                if let Some(lp) = corrections {
-                    *lp = l_pressure;
-                }
-            });
+            .for_each(
+                |(i, ((((role, row_vector), normal), corrections), strain_rate))| {
+                    let mut truncation = LaplacianTruncation::new(p, fluids_differ, i);
+                    let u_i = p.velocity(i);
+                    let mut grad_u = strain_rate.as_ref().map(|_| VelocityGradientSum::new(u_i));
+                    let mo = sph::support_moments_and(nb, p, i, |l, vf, followed| {
+                        truncation.add(nb, p, l, followed);
+                        if let Some(grad_u) = &mut grad_u {
+                            grad_u.add(l, vf, sph::fluid_velocity(p, u_i, l));
+                        }
+                    });
+                    if let (Some(rate), Some(grad_u)) = (strain_rate, &grad_u) {
+                        let g = grad_u.total();
+                        // L_i as the kernel correction inverts it, from the same moments.
+                        let l = sph::gradient_correction(mo.m, set.min_correction_determinant);
+                        *rate = [
+                            les::strain_rate(g),
+                            les::strain_rate(sph::corrected_gradient(&l, g)),
+                        ];
+                    }
+                    let l_pressure =
+                        sph::gradient_correction(mo.m_neumann, set.min_correction_determinant);
+                    let support = Support::new(&mo.m, mo.grad_c);
+                    // Fluid that fills its container has no free surface: every row is interior
+                    // (a disordered patch of a periodic flow can look like a surface to the
+                    // detection).
+                    *role = if set.confined {
+                        Role::Interior
+                    } else {
+                        ppe::role(
+                            nb,
+                            p,
+                            &support,
+                            mo.fluid_neighbours,
+                            l_pressure.is_some(),
+                            set.spray_density,
+                            i,
+                        )
+                    };
+                    // ĉ_i = L'_iᵀ c_i with the kernel correction, c_i without it.
+                    let l_row = if corrections.is_some() {
+                        &l_pressure
+                    } else {
+                        &None
+                    };
+                    *row_vector = ppe::row_vector(*role, &truncation, l_row);
+                    if let Some(normal) = normal {
+                        *normal = support.normal;
+                    }
+                    if let Some(lp) = corrections {
+                        *lp = l_pressure;
+                    }
+                },
+            );
         self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
         if let Some(reference) = self.reference {
             self.row_vectors[reference] = [0.0; D];
@@ -140,6 +172,11 @@ impl<const D: usize> FreeSurface<D> {
 
     pub fn full_support(&self) -> &[bool] {
         &self.full_support
+    }
+
+    /// The strain rates of the velocity gradients, [uncorrected, corrected] (with LES).
+    pub fn strain_rates(&self) -> Option<&[[f64; 2]]> {
+        self.strain_rates.as_deref()
     }
 
     /// Pins fluid particle `i` to P = 0, the role the free surface plays elsewhere (the
@@ -183,6 +220,10 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
         }
         what +=
             "; the PPE rows' vectors ĉ_i of the consistent Laplacian (Eq. 27), in the same walk";
+        if self.strain_rates.is_some() {
+            what +=
+                "; the velocity gradient's strain rate for the eddy viscosity, in the same walk";
+        }
         what
     }
 
@@ -197,6 +238,9 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
         }
         if let Some(normals) = &self.surface_normal {
             arrays.push(ArraySize::of("surface normal", normals));
+        }
+        if let Some(rates) = &self.strain_rates {
+            arrays.push(ArraySize::of("strain rate", rates));
         }
         arrays
     }
@@ -220,8 +264,9 @@ mod tests {
         corrected: bool,
     ) -> [f64; 2] {
         let mut truncation = LaplacianTruncation::new(p, false, i);
-        let mo =
-            sph::support_moments_and(nb, p, i, |l, followed| truncation.add(nb, p, l, followed));
+        let mo = sph::support_moments_and(nb, p, i, |l, _, followed| {
+            truncation.add(nb, p, l, followed)
+        });
         let l = if corrected {
             sph::gradient_correction(
                 mo.m_neumann,

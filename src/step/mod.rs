@@ -352,7 +352,11 @@ impl<const D: usize> Step<D> {
                 None => Corrections::sparse(false, &[], &[]),
             };
             let eddy = self.eddy_viscosity.as_mut().map(|stage| {
-                let eddy = stage.run(&nb, p, corrections, set.spacing, nf);
+                let strain_rates = self
+                    .free_surface
+                    .strain_rates()
+                    .expect("with LES the free surface's walk finds the strain rates");
+                let eddy = stage.run(strain_rates, corrections, set.spacing);
                 laps.lap(eddy_viscosity::NAME);
                 eddy
             });
