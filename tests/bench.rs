@@ -21,7 +21,6 @@ const COLUMNS: &[&str] = &[
     "step_max_s",
     "us_per_fluid_particle_step",
     "cell_list_s",
-    "density_s",
     "free_surface_s",
     "kernel_correction_s",
     "eddy_viscosity_s",

@@ -80,19 +80,20 @@ pub fn fluid_volumes<const D: usize>(p: &Particles<D>, nf: usize, out: &mut Vec<
 /// row, or P = 0 where it has no consistent gradient (`gradient_defined` false: the moment
 /// matrix of its pressure gradient is near-singular, whether or not the scene applies the
 /// kernel correction). `fluid_neighbours` counts the fluid particles in its kernel support;
-/// `spray_density` is the kernel's `free_surface::spray_density`.
+/// `density_ratio` is its summation density over its rest density, `spray_density` the
+/// kernel's `free_surface::spray_density`.
 pub fn role<const D: usize>(
     nb: &Neighbours<D>,
-    p: &Particles<D>,
     support: &Support<D>,
     fluid_neighbours: usize,
     gradient_defined: bool,
+    density_ratio: f64,
     spray_density: f64,
     i: usize,
 ) -> Role {
     if fluid_neighbours == 0 || !gradient_defined {
         Role::Splash
-    } else if support.is_free_surface(nb, i, p.density[i] / p.rest_density[i], spray_density) {
+    } else if support.is_free_surface(nb, i, density_ratio, spray_density) {
         Role::Surface
     } else {
         Role::Interior

@@ -30,17 +30,53 @@ pub fn density_and_nearest<const D: usize>(
     p: &Particles<D>,
     i: usize,
 ) -> (f64, f64) {
-    let mut rho = Sum::ZERO;
-    let rho0_i = F64s::splat(p.rest_density[i]);
-    let far = F64s::splat(f64::INFINITY);
-    let mut nearest = far;
-    nb.for_each_lanes(i, |l| {
-        rho += (mass_at_density(p, rho0_i, l) * nb.kernel.w_lanes(l.r)) & l.mask;
-        nearest = nearest.fast_min(l.mask.select(l.r, far));
-    });
-    let rho = (p.mass[i] * nb.kernel.w(0.0) + rho.total()) * nb.kernel.density_scale();
-    let nearest = nearest.to_array().into_iter().fold(f64::INFINITY, f64::min);
-    (rho, nearest)
+    let mut sum = DensitySum::new(p, i);
+    nb.for_each_lanes(i, |l| sum.add(nb, p, l));
+    sum.total(nb, p, i)
+}
+
+/// The sums of `density_and_nearest`, chunk by chunk: for a walk that sums them beside others
+/// (the support moments', in the free-surface stage).
+pub struct DensitySum {
+    rho: Sum,
+    rho0_i: F64s,
+    nearest: F64s,
+}
+
+impl DensitySum {
+    /// The sums at particle i.
+    pub fn new<const D: usize>(p: &Particles<D>, i: usize) -> Self {
+        Self {
+            rho: Sum::ZERO,
+            rho0_i: F64s::splat(p.rest_density[i]),
+            nearest: F64s::splat(f64::INFINITY),
+        }
+    }
+
+    /// Adds the lanes `l`.
+    #[inline(always)]
+    pub fn add<const D: usize>(&mut self, nb: &Neighbours<D>, p: &Particles<D>, l: &Lanes<D>) {
+        self.rho += (mass_at_density(p, self.rho0_i, l) * nb.kernel.w_lanes(l.r)) & l.mask;
+        self.nearest = self
+            .nearest
+            .fast_min(l.mask.select(l.r, F64s::splat(f64::INFINITY)));
+    }
+
+    /// ρ_i, with particle i's own share, and the distance to its nearest neighbour.
+    pub fn total<const D: usize>(
+        &self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        i: usize,
+    ) -> (f64, f64) {
+        let rho = (p.mass[i] * nb.kernel.w(0.0) + self.rho.total()) * nb.kernel.density_scale();
+        let nearest = self
+            .nearest
+            .to_array()
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        (rho, nearest)
+    }
 }
 
 /// m_j ρ0_i/ρ0_j = ρ0_i V_j of the lanes: the mass of neighbour j's volume at particle i's rest

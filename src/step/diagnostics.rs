@@ -13,7 +13,7 @@ pub struct Diagnostics;
 /// summation density is not truncated), in one pass:
 /// - the density error, mean |ρ/ρ0 − 1|;
 /// - the particle disorder, the coefficient of variation (standard deviation over mean) of
-///   the distance from each particle to its nearest neighbour (`nearest`, from the density's
+///   the distance from each particle to its nearest neighbour (`nearest`, from the free surface's
 ///   walk): zero on a lattice, a few per cent when particles stay well spread, growing as they
 ///   cluster into lines and gaps (tensile instability, no shifting).
 ///

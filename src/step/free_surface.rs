@@ -1,6 +1,7 @@
-//! How each kernel support is filled, from its moments (`sph::support_moments_and`): the free
-//! surface and the role of each fluid particle in the PPE (`ppe::role`), the particles with no
-//! free surface in reach, and what the same walk gives at no extra pass: the pressure
+//! How each kernel support is filled, from its moments (`sph::support_moments_and`) and its
+//! summation density (`sph::DensitySum`, with the nearest neighbour's distance), summed in one
+//! walk: the free surface and the role of each fluid particle in the PPE (`ppe::role`), the
+//! particles with no free surface in reach, and what the same walk gives at no extra pass: the pressure
 //! gradient's L'_i of Eq. (25) with the kernel correction, the surface normal with shifting,
 //! the PPE's row vectors ĉ_i (`ppe::row_vector`), and with LES the strain rate of the velocity
 //! gradient (`sph::VelocityGradientSum`: the same neighbours with the same V_j ∇W_ij factor as
@@ -15,13 +16,17 @@ use crate::particles::Particles;
 use crate::scene::Effects;
 use crate::solver::ppe::{self, LaplacianTruncation, Role};
 use crate::sph::free_surface::Support;
-use crate::sph::{self, Correction, Corrections, VelocityGradientSum};
+use crate::sph::{self, Correction, Corrections, DensitySum, VelocityGradientSum};
 use rayon::iter::Either;
 use rayon::prelude::*;
 
 pub const NAME: &str = "free surface";
 
 pub struct FreeSurface<const D: usize> {
+    /// Summation density of the step (copied into the particles).
+    density: Vec<f64>,
+    /// Distance to the nearest neighbour (the disorder of `stats.csv`).
+    nearest: Vec<f64>,
     roles: Vec<Role>,
     /// The particle pinned to P = 0 where the fluid has no free surface (`ppe::pin_reference`;
     /// None: the fluid has one, its pressure is absolute and cannot hold a tension).
@@ -58,6 +63,8 @@ pub struct Surface<'a, const D: usize> {
 impl<const D: usize> FreeSurface<D> {
     pub fn new(effects: &Effects) -> Self {
         Self {
+            density: Vec::new(),
+            nearest: Vec::new(),
             roles: Vec::new(),
             reference: None,
             full_support: Vec::new(),
@@ -79,6 +86,12 @@ impl<const D: usize> FreeSurface<D> {
         nf: usize,
     ) {
         let n = nf;
+        let (corrected, les) = (
+            self.pressure_corrections.is_some(),
+            self.strain_rates.is_some(),
+        );
+        self.density.resize(n, 0.0);
+        self.nearest.resize(n, 0.0);
         self.roles.resize(n, Role::Interior);
         self.row_vectors.resize(n, [0.0; D]);
         let corrections = match &mut self.pressure_corrections {
@@ -102,72 +115,43 @@ impl<const D: usize> FreeSurface<D> {
             }
             None => Either::Right((0..n).into_par_iter().map(|_| None)),
         };
-        self.roles
+        self.density
             .par_iter_mut()
+            .zip(&mut self.nearest)
+            .zip(&mut self.roles)
             .zip(&mut self.row_vectors)
-            .zip(normals)
-            .zip(corrections)
-            .zip(strain_rates)
+            .zip(normals.zip(corrections).zip(strain_rates))
             .enumerate()
-            .for_each(
-                |(i, ((((role, row_vector), normal), corrections), strain_rate))| {
-                    let mut truncation = LaplacianTruncation::new(p, fluids_differ, i);
-                    let u_i = p.velocity(i);
-                    let mut grad_u = strain_rate.as_ref().map(|_| VelocityGradientSum::new(u_i));
-                    let mo = sph::support_moments_and(nb, p, i, |l, vf, followed| {
-                        truncation.add(nb, p, l, followed);
-                        if let Some(grad_u) = &mut grad_u {
-                            grad_u.add(l, vf, sph::fluid_velocity(p, u_i, l));
-                        }
-                    });
-                    if let (Some(rate), Some(grad_u)) = (strain_rate, &grad_u) {
-                        let g = grad_u.total();
-                        // L_i as the kernel correction inverts it, from the same moments.
-                        let l = sph::gradient_correction(mo.m, set.min_correction_determinant);
-                        *rate = [
-                            les::strain_rate(g),
-                            les::strain_rate(sph::corrected_gradient(&l, g)),
-                        ];
-                    }
-                    let l_pressure =
-                        sph::gradient_correction(mo.m_neumann, set.min_correction_determinant);
-                    let support = Support::new(&mo.m, mo.grad_c);
-                    // Fluid that fills its container has no free surface: every row is interior
-                    // (a disordered patch of a periodic flow can look like a surface to the
-                    // detection).
-                    *role = if set.confined {
-                        Role::Interior
-                    } else {
-                        ppe::role(
-                            nb,
-                            p,
-                            &support,
-                            mo.fluid_neighbours,
-                            l_pressure.is_some(),
-                            set.spray_density,
-                            i,
-                        )
-                    };
-                    // ĉ_i = L'_iᵀ c_i with the kernel correction, c_i without it.
-                    let l_row = if corrections.is_some() {
-                        &l_pressure
-                    } else {
-                        &None
-                    };
-                    *row_vector = ppe::row_vector(*role, &truncation, l_row);
-                    if let Some(normal) = normal {
-                        *normal = support.normal;
-                    }
-                    if let Some(lp) = corrections {
-                        *lp = l_pressure;
-                    }
-                },
-            );
+            .for_each(|(i, ((((density, nearest), role), row_vector), outputs))| {
+                let ((normal, correction), strain_rate) = outputs;
+                let s = particle_support(nb, p, set, fluids_differ, corrected, les, i);
+                (*density, *nearest, *role, *row_vector) =
+                    (s.density, s.nearest, s.role, s.row_vector);
+                if let Some(normal) = normal {
+                    *normal = s.normal;
+                }
+                if let Some(lp) = correction {
+                    *lp = s.pressure_correction;
+                }
+                if let (Some(rate), Some(s)) = (strain_rate, s.strain_rate) {
+                    *rate = s;
+                }
+            });
         self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
         if let Some(reference) = self.reference {
             self.row_vectors[reference] = [0.0; D];
         }
         ppe::full_support(nb, &self.roles, &mut self.full_support);
+    }
+
+    /// The summation density of the last `run`.
+    pub fn density(&self) -> &[f64] {
+        &self.density
+    }
+
+    /// Each fluid particle's distance to its nearest neighbour, from the last `run`.
+    pub fn nearest(&self) -> &[f64] {
+        &self.nearest
     }
 
     pub fn full_support(&self) -> &[bool] {
@@ -205,13 +189,89 @@ impl<const D: usize> FreeSurface<D> {
     }
 }
 
+/// What the walk of fluid particle i's kernel support gives (`FreeSurface::run`).
+struct ParticleSupport<const D: usize> {
+    density: f64,
+    nearest: f64,
+    role: Role,
+    row_vector: [f64; D],
+    normal: [f64; D],
+    /// L'_i.
+    pressure_correction: Correction<D>,
+    /// |S| of the velocity gradient, [uncorrected, corrected by L_i] (with LES).
+    strain_rate: Option<[f64; 2]>,
+}
+
+/// Walks the kernel support of fluid particle i once for its summation density, its moments,
+/// its PPE row vector and (with `les`) its velocity gradient, and classifies it; `corrected`:
+/// the kernel correction is on.
+fn particle_support<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    set: &StepSettings<D>,
+    fluids_differ: bool,
+    corrected: bool,
+    les: bool,
+    i: usize,
+) -> ParticleSupport<D> {
+    let mut density = DensitySum::new(p, i);
+    let mut truncation = LaplacianTruncation::new(p, fluids_differ, i);
+    let u_i = p.velocity(i);
+    let mut grad_u = les.then(|| VelocityGradientSum::new(u_i));
+    let mo = sph::support_moments_and(nb, p, i, |l, vf, followed| {
+        density.add(nb, p, l);
+        truncation.add(nb, p, l, followed);
+        if let Some(grad_u) = &mut grad_u {
+            grad_u.add(l, vf, sph::fluid_velocity(p, u_i, l));
+        }
+    });
+    let (density, nearest) = density.total(nb, p, i);
+    let strain_rate = grad_u.map(|grad_u| {
+        let g = grad_u.total();
+        // L_i as the kernel correction inverts it, from the same moments.
+        let l = sph::gradient_correction(mo.m, set.min_correction_determinant);
+        [
+            les::strain_rate(g),
+            les::strain_rate(sph::corrected_gradient(&l, g)),
+        ]
+    });
+    let pressure_correction =
+        sph::gradient_correction(mo.m_neumann, set.min_correction_determinant);
+    let support = Support::new(&mo.m, mo.grad_c);
+    // Fluid that fills its container has no free surface: every row is interior (a disordered
+    // patch of a periodic flow can look like a surface to the detection).
+    let role = if set.confined {
+        Role::Interior
+    } else {
+        let gradient_defined = pressure_correction.is_some();
+        let ratio = density / p.rest_density[i];
+        let (neighbours, spray) = (mo.fluid_neighbours, set.spray_density);
+        ppe::role(nb, &support, neighbours, gradient_defined, ratio, spray, i)
+    };
+    // ĉ_i = L'_iᵀ c_i with the kernel correction, c_i without it.
+    let l_row = if corrected {
+        &pressure_correction
+    } else {
+        &None
+    };
+    ParticleSupport {
+        density,
+        nearest,
+        role,
+        row_vector: ppe::row_vector(role, &truncation, l_row),
+        normal: support.normal,
+        pressure_correction,
+        strain_rate,
+    }
+}
+
 impl<const D: usize> Stage<D> for FreeSurface<D> {
     fn name(&self) -> &'static str {
         NAME
     }
 
     fn describe(&self, _: &StepSettings<D>) -> String {
-        let mut what = "moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".to_string();
+        let mut what = "summation density ρ_i = ρ0_i Σ_j V_j W_ij (walls keep ρ0) and the distance to the nearest neighbour (the disorder in stats.csv); moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".to_string();
         if self.pressure_corrections.is_some() {
             what += "; L'_i of Eq. (25) for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only), inverted from the same moments";
         }
@@ -229,6 +289,8 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
 
     fn arrays(&self) -> Vec<ArraySize> {
         let mut arrays = vec![
+            ArraySize::of("density", &self.density),
+            ArraySize::of("nearest neighbour", &self.nearest),
             ArraySize::of("PPE role", &self.roles),
             ArraySize::of("full support", &self.full_support),
             ArraySize::of("PPE row vector", &self.row_vectors),

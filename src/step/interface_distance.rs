@@ -2,6 +2,7 @@
 //! interface and normal across it (`sph::interface`): the PPE rows and the pressure gradient
 //! weigh the pairs across it.
 
+use super::{Stage, StepSettings};
 use crate::boundary::faces::Faces;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_scalar_and_vector;
@@ -9,6 +10,8 @@ use crate::math::vector::unit;
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Particles};
 use crate::sph::interface::{self, Interfaces};
+
+pub const NAME: &str = "interface distance";
 
 pub struct InterfaceDistance<const D: usize> {
     /// The kernel's table of distances to an interface.
@@ -49,8 +52,18 @@ impl<const D: usize> InterfaceDistance<D> {
             normal: &self.normal,
         }
     }
+}
 
-    pub fn arrays(&self) -> Vec<ArraySize> {
+impl<const D: usize> Stage<D> for InterfaceDistance<D> {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn describe(&self, _: &StepSettings<D>) -> String {
+        "each fluid particle's distance to the nearest interface between fluids of different rest density and the normal across it, from the other fluid's share of its kernel (the walls mirroring the fluid), for the pairs across it".into()
+    }
+
+    fn arrays(&self) -> Vec<ArraySize> {
         vec![
             ArraySize::of("interface distance", &self.distance),
             ArraySize::of_components("interface normal", &self.normal),

@@ -14,7 +14,7 @@
 //! up to the corrector; `rigid_bodies` then moves them rigidly (`bodies`).
 //! `Particles`, the lasting state, is written at named points only, each marked "Into the
 //! particles" in `advance`: the order of every array (the cell sort), the summation density
-//! (`density`), the pressures and PPE roles (`pressure_solve`), the new velocity (`corrector`,
+//! (`free_surface`), the pressures and PPE roles (`pressure_solve`), the new velocity (`corrector`,
 //! the bodies' particles' from `rigid_bodies`),
 //! the walls' pressures on a frame (`wall_pressure`), the shifted velocity and pressure
 //! (`shifting`, over its own displacement plus the `density_correction`'s), the positions
@@ -31,7 +31,6 @@ mod advection;
 mod body_forces;
 mod cell_list;
 mod corrector;
-mod density;
 mod density_correction;
 mod diagnostics;
 mod eddy_viscosity;
@@ -180,7 +179,7 @@ pub struct Step<const D: usize> {
     kernel: Kernel<D>,
     faces: Faces,
     cell_list: cell_list::CellSort<D>,
-    density: density::Density<D>,
+    interface_distance: Option<interface_distance::InterfaceDistance<D>>,
     free_surface: free_surface::FreeSurface<D>,
     kernel_correction: Option<kernel_correction::KernelCorrection<D>>,
     eddy_viscosity: Option<eddy_viscosity::EddyViscosity>,
@@ -218,7 +217,7 @@ impl<const D: usize> Step<D> {
             kernel,
             faces,
             cell_list: cell_list::CellSort::new(grid),
-            density: density::Density::new(interfaces),
+            interface_distance: interfaces.map(interface_distance::InterfaceDistance::new),
             free_surface: free_surface::FreeSurface::new(effects),
             kernel_correction: effects
                 .kernel_correction
@@ -250,8 +249,11 @@ impl<const D: usize> Step<D> {
 
     /// The stages that run, in the order `advance` runs them.
     pub fn stages(&self) -> Vec<&dyn Stage<D>> {
-        let mut stages: Vec<&dyn Stage<D>> =
-            vec![&self.cell_list, &self.density, &self.free_surface];
+        let mut stages: Vec<&dyn Stage<D>> = vec![&self.cell_list];
+        if let Some(s) = &self.interface_distance {
+            stages.push(s);
+        }
+        stages.push(&self.free_surface);
         if let Some(s) = &self.kernel_correction {
             stages.push(s);
         }
@@ -335,12 +337,14 @@ impl<const D: usize> Step<D> {
             let nb = Neighbours::new(self.cell_list.grid(), &p.pos, self.kernel);
             // The time-step limit is in no stage (`isph bench`'s "other").
             laps.skip();
-            self.density.run(&nb, p, &self.faces, nf);
-            // Into the particles: ρ.
-            p.density[..nf].copy_from_slice(self.density.density());
-            let interfaces = self.density.interfaces();
-            laps.lap(density::NAME);
+            if let Some(stage) = &mut self.interface_distance {
+                stage.run(&nb, p, &self.faces, nf);
+                laps.lap(interface_distance::NAME);
+            }
+            let interfaces = self.interface_distance.as_ref().map(|s| s.field());
             self.free_surface.run(&nb, p, set, interfaces.is_some(), nf);
+            // Into the particles: ρ.
+            p.density[..nf].copy_from_slice(self.free_surface.density());
             laps.lap(free_surface::NAME);
             let full_support = self.free_surface.full_support();
             let corrections = match &mut self.kernel_correction {
@@ -441,7 +445,7 @@ impl<const D: usize> Step<D> {
             let (density_error, disorder) = diagnostics::full_support_statistics(
                 p,
                 surface.full_support,
-                self.density.nearest(),
+                self.free_surface.nearest(),
             );
             laps.part(diagnostics::NAME);
             if lands_on_target {
