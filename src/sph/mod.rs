@@ -19,24 +19,15 @@ use crate::particles::{Kind, Particles};
 /// taken for expanded (below 0.9 ρ0 it would be spray: `free_surface::spray_density`) nor the oil
 /// for compressed. The kernel's `density_scale` makes it ρ0 on the rest lattice.
 pub fn density<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> f64 {
-    density_and_nearest(nb, p, i).0
+    let mut sum = DensitySum::new(p, i);
+    nb.for_each_lanes(i, |l| sum.add(nb, p, l));
+    sum.total(nb, p, i).0
 }
 
 /// The summation density of `density` and, from the same walk, the distance from particle i
 /// to its nearest neighbour of any kind (infinite where it has none), which the particle
-/// disorder of `stats.csv` is measured from.
-pub fn density_and_nearest<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    i: usize,
-) -> (f64, f64) {
-    let mut sum = DensitySum::new(p, i);
-    nb.for_each_lanes(i, |l| sum.add(nb, p, l));
-    sum.total(nb, p, i)
-}
-
-/// The sums of `density_and_nearest`, chunk by chunk: for a walk that sums them beside others
-/// (the support moments', in the free-surface stage).
+/// disorder of `stats.csv` is measured from, chunk by chunk: for a walk that sums them beside
+/// others (the support moments', in the free-surface stage).
 pub struct DensitySum {
     rho: Sum,
     rho0_i: F64s,

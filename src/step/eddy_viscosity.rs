@@ -23,7 +23,6 @@ impl EddyViscosity {
         }
     }
 
-    /// ν_t of the `nf` fluid particles, from the velocity gradient corrected by `corrections`.
     /// ν_t of each fluid particle from its strain rates `strain_rates` ([uncorrected,
     /// corrected], the free surface's walk: `FreeSurface::strain_rates`), the corrected one
     /// where `corrections` corrects the particle's gradients.

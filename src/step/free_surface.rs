@@ -133,8 +133,8 @@ impl<const D: usize> FreeSurface<D> {
                 if let Some(lp) = correction {
                     *lp = s.pressure_correction;
                 }
-                if let (Some(rate), Some(s)) = (strain_rate, s.strain_rate) {
-                    *rate = s;
+                if let (Some(rate), Some(found)) = (strain_rate, s.strain_rate) {
+                    *rate = found;
                 }
             });
         self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
@@ -228,8 +228,12 @@ fn particle_support<const D: usize>(
     let (density, nearest) = density.total(nb, p, i);
     let strain_rate = grad_u.map(|grad_u| {
         let g = grad_u.total();
-        // L_i as the kernel correction inverts it, from the same moments.
-        let l = sph::gradient_correction(mo.m, set.min_correction_determinant);
+        // L_i exactly as the kernel correction inverts it (`KernelCorrection::run`: the same
+        // moments and bound), where it corrects the particle's gradients.
+        let l = match corrected {
+            true => sph::gradient_correction(mo.m, set.min_correction_determinant),
+            false => None,
+        };
         [
             les::strain_rate(g),
             les::strain_rate(sph::corrected_gradient(&l, g)),
@@ -340,34 +344,69 @@ mod tests {
         ppe::row_vector(Role::Interior, &truncation, &l)
     }
 
-    #[test]
-    fn the_row_vectors_take_the_pressure_correction_only_where_the_kernel_correction_is_on() {
-        // Water 16 × 10 spacings over four rows of floor, its free surface at the top.
-        let (dx, h_over_dx) = (0.01, 1.2);
+    const DX: f64 = 0.01;
+    const H_OVER_DX: f64 = 1.2;
+
+    /// Water 16 × 10 spacings over four rows of floor, its free surface at the top, sorted by
+    /// cell, moving with a shear `u = (sin(30 y), 0.5 cos(20 x))` m/s; and its fluid count.
+    fn water_over_a_floor() -> (Particles<2>, CellList<2>, Kernel<2>, usize) {
         let mut p = Particles::<2>::default();
         for ix in 0..16 {
             for iy in 0..14 {
                 let wall = iy < 4;
                 p.push(NewParticle {
-                    pos: [(ix as f64 + 0.5) * dx, (iy as f64 - 3.5) * dx],
+                    pos: [(ix as f64 + 0.5) * DX, (iy as f64 - 3.5) * DX],
                     kind: if wall { Kind::Wall } else { Kind::Fluid },
                     normal: if wall { [0.0, 1.0] } else { [0.0, 0.0] },
                     fluid: 0,
-                    mass: 1000.0 * dx * dx,
+                    mass: 1000.0 * DX * DX,
                     rest_density: 1000.0,
                     viscosity: 1e-6,
                 });
             }
         }
-        let kernel = Kernel::<2>::new(KernelKind::Quintic, dx, h_over_dx);
+        let kernel = Kernel::<2>::new(KernelKind::Quintic, DX, H_OVER_DX);
         let mut grid = CellList::new([-0.1, -0.1], [0.3, 0.3], kernel.support(), [false; 2]);
         let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
         grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
         p.permute(&order, &mut scratch);
-        let nb = Neighbours::new(&grid, &p.pos, kernel);
         let nf = grid.range_of(Kind::Fluid).end;
-        let density: Vec<f64> = (0..nf).map(|i| sph::density(&nb, &p, i)).collect();
-        p.density[..nf].copy_from_slice(&density);
+        for i in 0..nf {
+            let (x, y) = (p.pos[0][i], p.pos[1][i]);
+            (p.vel[0][i], p.vel[1][i]) = ((30.0 * y).sin(), 0.5 * (20.0 * x).cos());
+        }
+        (p, grid, kernel, nf)
+    }
+
+    fn settings(effects: Effects) -> StepSettings<2> {
+        StepSettings {
+            gravity: [0.0, -9.81],
+            ghost_pressure: GhostPressure::Hydrostatic,
+            spacing: DX,
+            alpha: 0.3,
+            solver: SolverParams {
+                tolerance: 1e-6,
+                max_iterations: 100,
+            },
+            effects,
+            confined: false,
+            spray_density: crate::sph::free_surface::spray_density::<2>(
+                KernelKind::Quintic,
+                H_OVER_DX,
+            ),
+            min_correction_determinant: sph::min_correction_determinant::<2>(
+                KernelKind::Quintic,
+                H_OVER_DX,
+            ),
+            cfl: 0.4,
+            max_viscosity: 1e-6,
+        }
+    }
+
+    #[test]
+    fn the_row_vectors_take_the_pressure_correction_only_where_the_kernel_correction_is_on() {
+        let (p, grid, kernel, nf) = water_over_a_floor();
+        let nb = Neighbours::new(&grid, &p.pos, kernel);
         let mut corrected_rows = 0;
         for corrected in [false, true] {
             let effects = Effects {
@@ -375,30 +414,8 @@ mod tests {
                 les: None,
                 kernel_correction: corrected,
             };
-            let set = StepSettings {
-                gravity: [0.0, -9.81],
-                ghost_pressure: GhostPressure::Hydrostatic,
-                spacing: dx,
-                alpha: 0.3,
-                solver: SolverParams {
-                    tolerance: 1e-6,
-                    max_iterations: 100,
-                },
-                effects,
-                confined: false,
-                spray_density: crate::sph::free_surface::spray_density::<2>(
-                    KernelKind::Quintic,
-                    h_over_dx,
-                ),
-                min_correction_determinant: sph::min_correction_determinant::<2>(
-                    KernelKind::Quintic,
-                    h_over_dx,
-                ),
-                cfl: 0.4,
-                max_viscosity: 1e-6,
-            };
             let mut stage = FreeSurface::new(&effects);
-            stage.run(&nb, &p, &set, false, nf);
+            stage.run(&nb, &p, &settings(effects), false, nf);
             let s = stage.output();
             for i in (0..nf).filter(|&i| s.roles[i] == Role::Interior) {
                 let expected = expected_row_vector(&nb, &p, i, corrected);
@@ -416,5 +433,51 @@ mod tests {
             corrected_rows > 10,
             "{corrected_rows} rows whose L' moves ĉ"
         );
+    }
+
+    /// The sums the stage makes in its one walk have the bits of walks of their own: the
+    /// summation density, the full supports (found from the surface's side) and the eddy
+    /// viscosity's strain rates, as and where the kernel correction stage corrects them.
+    #[test]
+    fn the_walk_gives_the_bits_of_walks_of_their_own() {
+        let (p, grid, kernel, nf) = water_over_a_floor();
+        let nb = Neighbours::new(&grid, &p.pos, kernel);
+        let effects = Effects {
+            shifting: None,
+            les: Some(crate::scene::LesSettings::default()),
+            kernel_correction: true,
+        };
+        let set = settings(effects);
+        let mut stage = FreeSurface::new(&effects);
+        stage.run(&nb, &p, &set, false, nf);
+        let (s, rates) = (stage.output(), stage.strain_rates().unwrap());
+        let mut kernel_correction = super::super::kernel_correction::KernelCorrection::default();
+        let corrections =
+            kernel_correction.run(&nb, &p, s.full_support, set.min_correction_determinant);
+        let (mut full, mut corrected) = (0, 0);
+        for i in 0..nf {
+            assert_eq!(stage.density()[i], sph::density(&nb, &p, i), "ρ of {i}");
+            let mut free_in_reach = false;
+            nb.for_each_of(i, &[Kind::Fluid], |j, _, _| {
+                free_in_reach |= s.roles[j].is_free()
+            });
+            let expected_full = s.roles[i] == Role::Interior && !free_in_reach;
+            assert_eq!(s.full_support[i], expected_full, "full support of {i}");
+            full += usize::from(expected_full);
+            let u_i = p.velocity(i);
+            let l = corrections.of(i);
+            let grad =
+                sph::velocity_gradient(&nb, &p, l, u_i, |l| sph::fluid_velocity(&p, u_i, l), i);
+            let rate = if l.is_some() {
+                rates[i][1]
+            } else {
+                rates[i][0]
+            };
+            assert_eq!(rate, les::strain_rate(grad), "|S| of {i}");
+            corrected += usize::from(l.is_some() && rates[i][1] != rates[i][0]);
+        }
+        // Both kinds of support, and corrected rates that differ from the plain ones.
+        assert!(full > 20 && full < nf - 20, "{full} full supports of {nf}");
+        assert!(corrected > 10, "{corrected} corrected strain rates");
     }
 }

@@ -54,6 +54,8 @@ impl<const D: usize> KernelCorrection<D> {
             .par_iter_mut()
             .zip(&self.corrected)
             .for_each(|(l, &i)| {
+                // The free surface's walk inverts the same moments for the eddy viscosity's
+                // strain rate (`free_surface::particle_support`): keep the two alike.
                 let moments = sph::support_moments(nb, p, i as usize);
                 *l = sph::gradient_correction(moments.m, min_determinant);
             });
