@@ -135,9 +135,16 @@ pub fn highest<const D: usize>(
 /// The free-surface particles (a small part of the fluid) mark the fluid they reach, instead of
 /// every interior row looking for one: the same pairs, as r_ji = −r_ij to the bit. Across a
 /// periodic boundary the two images of a pair round apart, so there a pair at the very edge of
-/// the support may be found from one side only.
-pub fn full_support<const D: usize>(nb: &Neighbours<D>, roles: &[Role], full: &mut Vec<bool>) {
-    let reached: Vec<AtomicBool> = roles.iter().map(|_| AtomicBool::new(false)).collect();
+/// the support may be found from one side only. `reached` is the marks' scratch.
+pub fn full_support<const D: usize>(
+    nb: &Neighbours<D>,
+    roles: &[Role],
+    reached: &mut Vec<AtomicBool>,
+    full: &mut Vec<bool>,
+) {
+    reached.clear();
+    reached.resize_with(roles.len(), || AtomicBool::new(false));
+    let reached = &*reached;
     roles
         .par_iter()
         .enumerate()

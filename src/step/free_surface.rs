@@ -19,6 +19,7 @@ use crate::sph::free_surface::Support;
 use crate::sph::{self, Correction, Corrections, DensitySum, VelocityGradientSum};
 use rayon::iter::Either;
 use rayon::prelude::*;
+use std::sync::atomic::AtomicBool;
 
 pub const NAME: &str = "free surface";
 
@@ -33,6 +34,8 @@ pub struct FreeSurface<const D: usize> {
     reference: Option<usize>,
     /// No free-surface particle in the kernel support.
     full_support: Vec<bool>,
+    /// Whether a free-surface particle reaches it (`ppe::full_support`'s scratch).
+    reached: Vec<AtomicBool>,
     /// The correction L'_i of the pressure gradient, whose wall ghosts carry the normal part
     /// of the gradient only (see `sph::Moments`) (with the kernel correction).
     pressure_corrections: Option<Vec<Correction<D>>>,
@@ -68,6 +71,7 @@ impl<const D: usize> FreeSurface<D> {
             roles: Vec::new(),
             reference: None,
             full_support: Vec::new(),
+            reached: Vec::new(),
             pressure_corrections: effects.kernel_correction.then(Vec::new),
             surface_normal: effects.shifting.map(|_| Vec::new()),
             row_vectors: Vec::new(),
@@ -141,7 +145,7 @@ impl<const D: usize> FreeSurface<D> {
         if let Some(reference) = self.reference {
             self.row_vectors[reference] = [0.0; D];
         }
-        ppe::full_support(nb, &self.roles, &mut self.full_support);
+        ppe::full_support(nb, &self.roles, &mut self.reached, &mut self.full_support);
     }
 
     /// The summation density of the last `run`.
@@ -297,6 +301,7 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
             ArraySize::of("nearest neighbour", &self.nearest),
             ArraySize::of("PPE role", &self.roles),
             ArraySize::of("full support", &self.full_support),
+            ArraySize::of("free surface in reach", &self.reached),
             ArraySize::of("PPE row vector", &self.row_vectors),
         ];
         if let Some(l) = &self.pressure_corrections {
