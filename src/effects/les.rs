@@ -39,8 +39,8 @@ pub fn strain_rate<const D: usize>(grad: [[f64; D]; D]) -> f64 {
 }
 
 /// Smagorinsky eddy viscosity ν_t = (Cs Δ)² |S| (Eq. 3), with `strain_rate` |S| of the
-/// velocity gradient, corrected where L_i applies (the walls free-slip ghosts, `sph::fluid_velocity`) and Δ the
-/// particle spacing.
+/// velocity gradient, corrected where L_i applies (the walls free-slip ghosts,
+/// `sph::fluid_velocity`), and Δ the particle spacing.
 pub fn eddy_viscosity(strain_rate: f64, cs: f64, spacing: f64) -> f64 {
     let cs_delta = cs * spacing;
     cs_delta * cs_delta * strain_rate

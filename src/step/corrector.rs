@@ -163,9 +163,10 @@ fn pressure_gradients<const D: usize, const K: usize>(
 }
 
 /// The pressures (of each of the K fields `pressures`) at fluid particle i that its pressure
-/// gradients take the differences P_j − P_i from, the K fits in one walk: P_i itself, but for an unknown of the PPE with the free surface in its
-/// kernel support (`role` Interior, not `full_support`) the value P̃_i of the linear function
-/// fitted to its fluid neighbours' pressures (`sph::fitted_values`; P_i where they fix none).
+/// gradients take the differences P_j − P_i from, the K fits in one walk: P_i itself, but for
+/// an unknown of the PPE with the free surface in its kernel support (`role` Interior, not
+/// `full_support`) the value P̃_i of the linear function fitted to its fluid neighbours'
+/// pressures (`sph::fitted_values`; P_i where they fix none).
 /// Both are exact for a linear field. Where the surface truncates the support, the difference
 /// form carries the term −P_i L'_i Σ_j V_j ∇W_ij, which points out of the fluid: a particle
 /// whose pressure dips below its neighbours' is pushed towards the surface, and the projection

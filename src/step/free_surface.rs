@@ -1,9 +1,9 @@
 //! How each kernel support is filled, from its moments (`sph::support_moments_and`) and its
 //! summation density (`sph::DensitySum`, with the nearest neighbour's distance), summed in one
 //! walk: the free surface and the role of each fluid particle in the PPE (`ppe::role`), the
-//! particles with no free surface in reach, and what the same walk gives at no extra pass: the pressure
-//! gradient's L'_i of Eq. (25) with the kernel correction, the surface normal with shifting,
-//! the PPE's row vectors ĉ_i (`ppe::row_vector`), and with LES the strain rate of the velocity
+//! particles with no free surface in reach, and what the same walk gives at no extra pass: the
+//! pressure gradient's L'_i of Eq. (25) with the kernel correction, the surface normal with
+//! shifting, the PPE's row vectors ĉ_i (`ppe::row_vector`), and with LES the strain rate of the velocity
 //! gradient (`sph::VelocityGradientSum`: the same neighbours with the same V_j ∇W_ij factor as
 //! the moments) both as summed and corrected by L_i = M_i⁻¹ of the same moments, for the eddy
 //! viscosity to take the one the kernel correction asks for once the free surface is known.
@@ -234,9 +234,10 @@ fn particle_support<const D: usize>(
         let g = grad_u.total();
         // L_i exactly as the kernel correction inverts it (`KernelCorrection::run`: the same
         // moments and bound), where it corrects the particle's gradients.
-        let l = match corrected {
-            true => sph::gradient_correction(mo.m, set.min_correction_determinant),
-            false => None,
+        let l = if corrected {
+            sph::gradient_correction(mo.m, set.min_correction_determinant)
+        } else {
+            None
         };
         [
             les::strain_rate(g),
@@ -341,7 +342,7 @@ mod tests {
         let l = if corrected {
             sph::gradient_correction(
                 mo.m_neumann,
-                sph::min_correction_determinant::<2>(KernelKind::Quintic, 1.2),
+                sph::min_correction_determinant::<2>(KernelKind::Quintic, H_OVER_DX),
             )
         } else {
             None
