@@ -67,30 +67,52 @@ fn dam_break_3d_runs_half_a_second() {
 
 /// Lobovsky et al.'s dam break (`scenes/dam_break_lobovsky_2d.toml`, H/40, dx = 7.5 mm) to
 /// t = 0.55 s (t √(g/H) = 3.1, past every sensor's onset): the time the water reaches each
-/// sensor within 3% of the experiment's. A sensor whose centre lies below the first layer of
-/// fluid particles (half a spacing, 3.75 mm: sensor 1, at 3 mm) is not resolved and not asked
-/// for. Measured at H/40: −0.1%, −2.4%, +1.2% at sensors 2–4: at this spacing the first water
-/// reaches sensors 1–3 in the same step, so their onsets differ by the experiment's only
-/// (docs/accuracy.md, "Wall pressures against Lobovsky et al. 2014").
+/// sensor within 3% of the experiment's, in the median of three draws. A run is one draw of the
+/// run-up: frames every 0.02, 0.025 (the scene's) and 0.03 s land other steps on them, and
+/// sensor 4's onset (80 mm, where the experiment's rise is slow) moves by up to 6 points between
+/// draws. A sensor whose centre lies below the first layer of fluid particles (half a spacing,
+/// 3.75 mm: sensor 1, at 3 mm) is not resolved and not asked for. Measured at H/40 (frames every
+/// 0.02, 0.025, 0.03 s): sensors 2–4 −0.4 / +0.2 / −0.2%, −2.5 / −0.4 / −2.4%, +2.3 / −1.8 /
+/// −1.1%, medians −0.2%, −2.4%, −1.1%
+/// (docs/accuracy.md, "Wall pressures against Lobovsky et al. 2014"). At this spacing the first
+/// water reaches sensors 1–3 in the same step, so their onsets differ by the experiment's only.
 #[test]
 fn wall_pressure_onsets_follow_lobovsky() {
     let scene = shipped_scene("dam_break_lobovsky_2d.toml");
     assert_eq!(scene.spacing, 0.0075);
-    let dir = TempDir::new("lobovsky");
-    run_scene(&scene, dir.path(), 0.55);
-    let m = measure(Case::LobovskyPressure, &scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
-    let detail = |name: String| m.details.iter().find(|(n, _)| *n == name).unwrap().1;
     let resolved: Vec<_> = SENSORS
         .iter()
         .filter(|s| s.height >= 0.5 * scene.spacing)
         .collect();
     assert_eq!(resolved.len(), 3);
-    for sensor in resolved {
-        let error = detail(format!("onset_error_{}", sensor.name));
+    let draws: Vec<Vec<f64>> = [0.02, 0.025, 0.03]
+        .iter()
+        .map(|&interval| {
+            let scene = isph::scene::Scene {
+                output_interval: interval,
+                ..scene.clone()
+            };
+            let dir = TempDir::new("lobovsky");
+            run_scene(&scene, dir.path(), 0.55);
+            let m = measure(Case::LobovskyPressure, &scene, dir.path())
+                .unwrap_or_else(|e| panic!("{e}"));
+            resolved
+                .iter()
+                .map(|sensor| {
+                    let name = format!("onset_error_{}", sensor.name);
+                    m.details.iter().find(|(n, _)| *n == name).unwrap().1
+                })
+                .collect()
+        })
+        .collect();
+    for (k, sensor) in resolved.iter().enumerate() {
+        let mut errors: Vec<f64> = draws.iter().map(|d| d[k]).collect();
+        errors.sort_by(f64::total_cmp);
         assert!(
-            error.abs() < 0.03,
-            "{}: onset error {error}: {m:?}",
-            sensor.name
+            errors[1].abs() < 0.03,
+            "{}: onset errors {errors:?}, median {}",
+            sensor.name,
+            errors[1]
         );
     }
 }
