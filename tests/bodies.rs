@@ -826,10 +826,9 @@ fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_nothing_passes_thr
     // quarters of the heavy discs on the floor, half the light ones afloat. Measured: heavy on
     // the floor 2, 4, 3 of 4, light afloat 2, 3, 4 of 4 (before the free-surface rows followed
     // the particles' rise, `ppe::surface_pressure`: 3, 3, 3 and 2, 4, 4).
-    let draws: Vec<Vec<f64>> = [0.02, 0.025, 0.03]
-        .iter()
-        .map(|&interval| solids_heights(interval))
-        .collect();
+    let mut scene = crate::common::shipped_scene("dam_break_solids_2d.toml");
+    scene.spacing = 0.01;
+    let draws: Vec<Vec<f64>> = crate::common::over_draws(&scene, solids_heights);
     for heights in &draws {
         eprintln!(
             "mean heights over 2–3 s: heavy {:?} m, light {:?} m",
@@ -852,15 +851,12 @@ fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_nothing_passes_thr
     assert!(afloat >= 6, "{afloat} of 12 light discs afloat: {draws:?}");
 }
 
-/// The dam break over solids of `in_a_dam_break_heavy_solids_…` with frames every `interval`:
-/// checks every frame for fluid inside a disc and for discs inside each other or the floor, and
+/// Runs the dam break over solids `scene` of `in_a_dam_break_heavy_solids_…` to 3 s: checks
+/// every frame for fluid inside a disc and for discs inside each other or the floor, and
 /// returns each disc's mean height over 2–3 s.
-fn solids_heights(interval: f64) -> Vec<f64> {
+fn solids_heights(scene: &isph::scene::Scene) -> Vec<f64> {
     let dir = TempDir::new("bodies-solids");
-    let mut scene = crate::common::shipped_scene("dam_break_solids_2d.toml");
-    scene.spacing = 0.01;
-    scene.output_interval = interval;
-    run_scene(&scene, dir.path(), 3.0);
+    run_scene(scene, dir.path(), 3.0);
     let discs: Vec<Vec<(f64, Vec<f64>)>> = (0..8).map(|b| rows(dir.path(), b)).collect();
     let (radius, spacing) = (0.025, scene.spacing);
     let circles: Vec<[f64; 2]> = scene

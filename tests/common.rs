@@ -312,3 +312,18 @@ max = {size}
         size = v(&size),
     )
 }
+
+/// `run` over three draws of a chaotic run of `scene`: frames every 0.02, 0.025 and 0.03 s land
+/// other steps on them (a step is cut short to land on a frame), and after a plunge or a pile-up
+/// each lands elsewhere. For tests that judge a chaotic outcome over draws, not on one.
+pub fn over_draws<T>(scene: &Scene, run: impl Fn(&Scene) -> T) -> Vec<T> {
+    [0.02, 0.025, 0.03]
+        .iter()
+        .map(|&interval| {
+            run(&Scene {
+                output_interval: interval,
+                ..scene.clone()
+            })
+        })
+        .collect()
+}

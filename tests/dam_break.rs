@@ -1,7 +1,7 @@
 //! Dam breaks: the 2D surge front against Martin & Moyce (1952), the wall pressures' onsets
 //! against Lobovsky et al. (2014), and a 3D run.
 
-use crate::common::{run_scene, shipped_scene, stats_column, TempDir};
+use crate::common::{over_draws, run_scene, shipped_scene, stats_column, TempDir};
 use isph::tools::validation::dam_break::Column;
 use isph::tools::validation::lobovsky::SENSORS;
 use isph::tools::validation::{measure, Case};
@@ -85,26 +85,19 @@ fn wall_pressure_onsets_follow_lobovsky() {
         .filter(|s| s.height >= 0.5 * scene.spacing)
         .collect();
     assert_eq!(resolved.len(), 3);
-    let draws: Vec<Vec<f64>> = [0.02, 0.025, 0.03]
-        .iter()
-        .map(|&interval| {
-            let scene = isph::scene::Scene {
-                output_interval: interval,
-                ..scene.clone()
-            };
-            let dir = TempDir::new("lobovsky");
-            run_scene(&scene, dir.path(), 0.55);
-            let m = measure(Case::LobovskyPressure, &scene, dir.path())
-                .unwrap_or_else(|e| panic!("{e}"));
-            resolved
-                .iter()
-                .map(|sensor| {
-                    let name = format!("onset_error_{}", sensor.name);
-                    m.details.iter().find(|(n, _)| *n == name).unwrap().1
-                })
-                .collect()
-        })
-        .collect();
+    let draws: Vec<Vec<f64>> = over_draws(&scene, |scene| {
+        let dir = TempDir::new("lobovsky");
+        run_scene(scene, dir.path(), 0.55);
+        let m =
+            measure(Case::LobovskyPressure, scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
+        resolved
+            .iter()
+            .map(|sensor| {
+                let name = format!("onset_error_{}", sensor.name);
+                m.details.iter().find(|(n, _)| *n == name).unwrap().1
+            })
+            .collect()
+    });
     for (k, sensor) in resolved.iter().enumerate() {
         let mut errors: Vec<f64> = draws.iter().map(|d| d[k]).collect();
         errors.sort_by(f64::total_cmp);

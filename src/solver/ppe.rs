@@ -219,10 +219,11 @@ pub fn row_vector<const D: usize>(
 /// its draft then read 8.7% less than its buoyancy at dx = 0.01 m and 4.2% at 0.005 m, and kept
 /// the water at its waterline moving at 0.16 m/s; with 0, +1.7% and +0.7%, 0.075 m/s
 /// (docs/bodies.md, "The coupling").
+/// `g` is |`gravity`|.
 fn surface_pressure<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    gravity: [f64; D],
+    (gravity, g): ([f64; D], f64),
     spacing: f64,
     dt: f64,
     i: usize,
@@ -230,7 +231,6 @@ fn surface_pressure<const D: usize>(
     match p.kind[i] {
         Kind::Body => 0.0,
         Kind::Fluid | Kind::Wall => {
-            let g = gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
             let rise = rise_over_neighbours(nb, p, i);
             let g_u: f64 = (0..D).map(|d| gravity[d] * rise[d]).sum();
             p.rest_density[i] * (0.5 * spacing * g - 0.5 * dt * g_u)
@@ -279,10 +279,11 @@ pub fn projection_source<const D: usize>(
     b: &mut Vec<f64>,
 ) {
     let (nb, p) = (op.nb, op.p);
+    let g = op.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     b.resize(op.roles.len(), 0.0);
     fill(b, |i| match op.roles[i] {
         Role::Interior => divergence_source(nb, p, corrections.of(i), u_star, dt, i),
-        Role::Surface => surface_pressure(nb, p, op.gravity, spacing, dt, i),
+        Role::Surface => surface_pressure(nb, p, (op.gravity, g), spacing, dt, i),
         Role::Splash | Role::Reference => 0.0,
     });
     balance_compression(op.roles, closed, sealed, b);
