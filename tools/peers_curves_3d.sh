@@ -8,7 +8,7 @@
 #
 # Usage: tools/peers_curves_3d.sh [SPACING=0.02] [UNTIL=0.6] [THREADS=2] [ROUNDS=3]
 # Environment: ISPH_SETTINGS (isph's [solver] settings, '|' between settings, ';' between the
-# keys of one, e.g. 'kernel = "wendland_c2"; h_over_dx = 1.8'; default "cfl = 0.24|cfl = 0.4|cfl = 0.6|cfl = 0.4; tolerance = 1e-3|cfl = 0.6; tolerance = 1e-3"),
+# keys of one, e.g. 'kernel = "wendland_c2"; h_over_dx = 1.8'; default "cfl = 0.24|cfl = 0.4|cfl = 0.6|cfl = 0.4; tolerance = 1e-6|cfl = 0.4; tolerance = 1e-3|cfl = 0.6; tolerance = 1e-3"),
 # MAXERRORS (SPlisHSPlasH's density tolerances in percent; default "0.01 0.1 1"), SOLVERS
 # (default "DFSPH IISPH"), ISPH, WORK (default /tmp/isph_peers_curves_3d), SPLASH_VENV.
 set -euo pipefail
@@ -20,7 +20,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 ISPH=${ISPH:-$ROOT/target/release/isph}
 WORK=${WORK:-/tmp/isph_peers_curves_3d}
 VENV=${SPLASH_VENV:-/tmp/peers_splash_venv}
-ISPH_SETTINGS=${ISPH_SETTINGS:-"cfl = 0.24|cfl = 0.4|cfl = 0.6|cfl = 0.4; tolerance = 1e-3|cfl = 0.6; tolerance = 1e-3"}
+ISPH_SETTINGS=${ISPH_SETTINGS:-"cfl = 0.24|cfl = 0.4|cfl = 0.6|cfl = 0.4; tolerance = 1e-6|cfl = 0.4; tolerance = 1e-3|cfl = 0.6; tolerance = 1e-3"}
 MAXERRORS=${MAXERRORS:-"0.01 0.1 1"}
 SOLVERS=${SOLVERS:-"DFSPH IISPH"}
 mkdir -p "$WORK"
