@@ -284,3 +284,30 @@ fn a_scene_without_the_sensors_is_not_measured_against_lobovsky() {
     let e = isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap_err();
     assert!(e.to_string().contains("no pressure probe named P1"), "{e}");
 }
+
+/// `density`: the worst step's density error, its mean over the steps that measured one (a NaN
+/// step measured nothing) and the wall crossings summed over the run.
+#[test]
+fn density_measure_takes_the_worst_step_and_the_mean_of_the_measured_ones() {
+    let dir = crate::common::TempDir::new("measure-density");
+    std::fs::write(
+        dir.path().join("stats.csv"),
+        "step,density_error,penetrations\n1,0.002,0\n2,NaN,1\n3,0.008,2\n4,0.005,0\n",
+    )
+    .unwrap();
+    let scene = crate::common::shipped_scene("violent_impact_2d.toml");
+    let m = isph::tools::validation::measure(Case::Density, &scene, dir.path()).unwrap();
+    assert_eq!(m.error, 0.008);
+    assert_eq!(m.details[0], ("density_error_mean".to_string(), 0.005));
+    assert_eq!(m.details[1], ("penetrations".to_string(), 3.0));
+    std::fs::write(
+        dir.path().join("stats.csv"),
+        "step,density_error,penetrations\n1,NaN,0\n",
+    )
+    .unwrap();
+    let e = isph::tools::validation::measure(Case::Density, &scene, dir.path()).unwrap_err();
+    assert!(
+        e.to_string().contains("no step with a density error"),
+        "{e}"
+    );
+}

@@ -3,6 +3,7 @@
 //! the validation tests assert. One file per case.
 
 pub mod dam_break;
+pub mod density;
 pub mod hydrostatic;
 pub mod lobovsky;
 pub mod poiseuille;
@@ -28,15 +29,18 @@ pub enum Case {
     TaylorGreen,
     /// Wall pressures of a dam break against Lobovsky et al. (2014) (`lobovsky.rs`).
     LobovskyPressure,
+    /// Any flow: its density against ρ0 over every step (`density.rs`).
+    Density,
 }
 
 impl Case {
-    pub const ALL: [Case; 5] = [
+    pub const ALL: [Case; 6] = [
         Case::Hydrostatic,
         Case::DamBreakFront,
         Case::Poiseuille,
         Case::TaylorGreen,
         Case::LobovskyPressure,
+        Case::Density,
     ];
 
     /// The name a study file gives (`measure = "…"`).
@@ -47,6 +51,7 @@ impl Case {
             Case::Poiseuille => "poiseuille",
             Case::TaylorGreen => "taylor_green",
             Case::LobovskyPressure => "lobovsky_pressure",
+            Case::Density => "density",
         }
     }
 
@@ -58,6 +63,7 @@ impl Case {
             Case::Poiseuille => &poiseuille::DETAILS,
             Case::TaylorGreen => &taylor_green::DETAILS,
             Case::LobovskyPressure => &lobovsky::DETAILS,
+            Case::Density => &density::DETAILS,
         }
     }
 }
@@ -133,6 +139,7 @@ pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, Va
         Case::Poiseuille => poiseuille::measure(scene, run_dir),
         Case::TaylorGreen => taylor_green::measure(scene, run_dir),
         Case::LobovskyPressure => lobovsky::measure(scene, run_dir),
+        Case::Density => density::measure(run_dir),
     }
 }
 
@@ -166,6 +173,7 @@ pub fn check(case: Case, scene: &Scene) -> Result<(), ValidationError> {
         Case::Poiseuille => poiseuille::Channel::of(scene).map(|_| ()),
         Case::TaylorGreen => taylor_green::Vortex::of(scene).map(|_| ()),
         Case::LobovskyPressure => lobovsky::Tank::new(scene).map(|_| ()),
+        Case::Density => Ok(()),
     }
 }
 
