@@ -10,19 +10,18 @@ use std::path::Path;
 
 const G: f64 = 9.81;
 
-/// A 2D dam break: a column `width` × 2 `width` of water at the left of a tank 4 `width` long,
-/// so that the surge hits the far wall, runs up it and overturns. `extra` is appended.
-fn dam_break(width: f64, spacing: f64, extra: &str) -> Scene {
-    scene(&format!(
-        "[simulation]\ndimensions = 2\nspacing = {spacing}\nend_time = 10.0\n\
-         output_interval = 0.05\ngravity = [0.0, -9.81]\n\
-         [[fluid]]\nname = \"water\"\ndensity = 1000.0\nviscosity = 1.0e-6\n\
-         [[fluid_block]]\nfluid = \"water\"\nmin = [0.0, 0.0]\nmax = [{width}, {height}]\n\
-         [container]\nmin = [0.0, 0.0]\nmax = [{length}, {top}]\n{extra}",
-        height = 2.0 * width,
-        length = 4.0 * width,
-        top = 3.5 * width,
-    ))
+/// The width a of the column of `scenes/violent_impact_2d.toml`.
+const WIDTH: f64 = 0.05715;
+
+/// `scenes/violent_impact_2d.toml`: a column a × 2a of water at the left of a tank 4a long, so
+/// that the surge hits the far wall, runs up it and overturns; at `spacing`, with `extra`
+/// appended to the scene's text.
+fn dam_break(spacing: f64, extra: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/violent_impact_2d.toml");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut s = scene(&format!("{text}{extra}"));
+    s.spacing = spacing;
+    s
 }
 
 /// Σ m (|u|²/2 + g y) over the fluid of a frame, per unit mass of fluid: kinetic plus potential
@@ -157,16 +156,15 @@ fn still_water_stays_at_rest_for_30_s() {
     assert_no_penetration(out);
 }
 
-/// The violent impact of the issue: the column `width` wide at `per_width` particles across,
-/// run to t = 8 √(H/g) with `extra` appended to the scene; returns the run's directory and its
-/// frame count.
-fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize) {
-    let width = 0.05715;
-    let s = dam_break(width, width / per_width, extra);
+/// The violent impact of the issue: the column at `per_width` particles across, run to
+/// t = 8 √(H/g) with `extra` appended to the scene; returns the run's directory, its frame count
+/// and the scene it ran.
+fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize, Scene) {
+    let s = dam_break(WIDTH / per_width, extra);
     let dir = TempDir::new(name);
-    let until = 8.0 * (2.0 * width / G).sqrt();
+    let until = 8.0 * (2.0 * WIDTH / G).sqrt();
     let frames = run_scene(&s, dir.path(), until).frames.len();
-    (dir, frames)
+    (dir, frames, s)
 }
 
 /// The issue's violent impact at a/40. After the plunge the flow is chaotic, so the worst step
@@ -178,9 +176,8 @@ fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize) {
 /// trajectories").
 #[test]
 fn violent_impact_keeps_density_and_volume() {
-    let (dir, frames) = violent_impact(40.0, "", "impact");
+    let (dir, frames, scene) = violent_impact(40.0, "", "impact");
     let out = dir.path();
-    let scene = dam_break(0.05715, 0.05715 / 40.0, "");
     let density = isph::tools::validation::measure(Case::Density, &scene, out).unwrap();
     let (worst, average) = (density.error, density.details[0].1);
     assert!(worst < 0.01, "mean density error reached {worst}");
@@ -205,11 +202,11 @@ fn violent_impact_keeps_density_and_volume() {
 /// draw of the chaotic flow, 0.146–0.215 over the same twelve: bounded only against a blow-up.
 #[test]
 fn shifting_keeps_the_violent_impact_ordered() {
-    let (shifted, _) = violent_impact(20.0, "", "impact_shifted");
+    let (shifted, _, _) = violent_impact(20.0, "", "impact_shifted");
     let disorder = stats_column(shifted.path(), "disorder");
     let half = disorder.len() / 2;
     let shifted_max = disorder[half..].iter().cloned().fold(0.0, f64::max);
-    let (plain, _) = violent_impact(
+    let (plain, _, _) = violent_impact(
         20.0,
         "[effects.shifting]\nenabled = false\n",
         "impact_unshifted",
@@ -297,10 +294,9 @@ fn high_viscosity_stays_smooth() {
 #[test]
 fn large_cfl_numbers_stay_stable() {
     for (cfl, bound) in [(0.75, 0.01), (1.0, 0.025)] {
-        let width = 0.05715;
-        let s = dam_break(width, width / 30.0, &format!("[solver]\ncfl = {cfl}\n"));
+        let s = dam_break(WIDTH / 30.0, &format!("[solver]\ncfl = {cfl}\n"));
         let dir = TempDir::new(&format!("cfl_{cfl}"));
-        let until = 8.0 * (2.0 * width / G).sqrt();
+        let until = 8.0 * (2.0 * WIDTH / G).sqrt();
         let frames = run_scene(&s, dir.path(), until).frames.len();
         let out = dir.path();
         assert_rare_crossings(out, frames, &format!("CFL {cfl}"));
