@@ -84,6 +84,19 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             &["simulation.spacing", "GiB of memory this machine has"],
         ),
         (
+            // A small block in a vast empty container: the container's lattice, not the
+            // particles, would fill the memory.
+            "max = [0.4, 0.3]",
+            "max = [1200.0, 1200.0]",
+            &["simulation.spacing", "lattice points", "GiB of memory this machine has"],
+        ),
+        (
+            // A body's lattice points are counted before they are made.
+            "max = [0.4, 0.3]",
+            "max = [1200.0, 1200.0]\n\n[[body]]\nshape = \"box\"\nmin = [1.0, 1.0]\nmax = [1199.0, 1199.0]\ndensity = 500.0\nmotion = \"free\"",
+            &["body[0].shape", "scene.toml:23", "GiB of memory this machine has"],
+        ),
+        (
             "dimensions = 2",
             "dimensions = 4",
             &["simulation.dimensions", "scene.toml:2", "2 or 3"],
@@ -492,6 +505,27 @@ fn each_bad_mesh_is_refused_with_its_key() {
     )
     .unwrap();
     std::fs::write(dir.path().join("bad.obj"), "v 0.1 0.1\nf 1 2 3\n").unwrap();
+    // A binary STL of one facet whose second vertex has a NaN coordinate.
+    let mut stl = vec![0u8; 80];
+    stl.extend(1u32.to_le_bytes());
+    for x in [
+        0.0f32,
+        0.0,
+        1.0,
+        0.1,
+        0.1,
+        0.1,
+        0.2,
+        f32::NAN,
+        0.1,
+        0.1,
+        0.2,
+        0.1,
+    ] {
+        stl.extend(x.to_le_bytes());
+    }
+    stl.extend(0u16.to_le_bytes());
+    std::fs::write(dir.path().join("nan.stl"), stl).unwrap();
     let scene = |body: &str| {
         crate::common::water_block_scene_3d([0.2, 0.2, 0.1], [0.4, 0.4, 0.4], 0.01, 0.01, body)
     };
@@ -499,6 +533,7 @@ fn each_bad_mesh_is_refused_with_its_key() {
         ("[[body]]\nshape = \"mesh\"\nmesh = \"missing.obj\"\ndensity = 500.0", &["body[0].mesh", "cannot read"]),
         ("[[body]]\nshape = \"mesh\"\nmesh = \"open.obj\"\ndensity = 500.0", &["body[0].mesh", "not closed", "4 of its edges"]),
         ("[[body]]\nshape = \"mesh\"\nmesh = \"bad.obj\"\ndensity = 500.0", &["body[0].mesh", "line 1", "three finite numbers"]),
+        ("[[body]]\nshape = \"mesh\"\nmesh = \"nan.stl\"\ndensity = 500.0", &["body[0].mesh", "facet 1", "three finite numbers"]),
         ("[[body]]\nshape = \"box\"\nmin = [0.1, 0.1, 0.2]\nmax = [0.2, 0.2, 0.3]\noffset = [0.0, 0.0, 0.0]\ndensity = 500.0", &["body[0].offset", "moves a mesh"]),
         ("[[fluid_block]]\nfluid = \"water\"\nmin = [0.0, 0.0, 0.2]\nmax = [0.1, 0.1, 0.3]\nmesh = \"open.obj\"", &["fluid_block[1]", "not both"]),
     ];
@@ -506,4 +541,98 @@ fn each_bad_mesh_is_refused_with_its_key() {
         let (code, stderr) = run_text(dir.path(), &scene(text), &[]);
         assert_refused(code, &stderr, expected);
     }
+}
+
+/// A periodic axis exactly three kernel supports long, 3 × 3h = n dx: the scene's check asks
+/// for more than three supports by more than rounding, so each such scene is refused with its
+/// key or builds, never a panic in the cell list (n = 10 … 40 spacings across, for the quintic and a Wendland kernel; an h/dx
+/// outside the kernel's range is refused by `solver.h_over_dx`).
+#[test]
+fn a_periodic_axis_three_supports_long_is_refused_or_built() {
+    for n in 10..=40 {
+        for (kernel, support_in_h) in [("quintic", 3.0), ("wendland_c2", 2.0)] {
+            let h_over_dx = n as f64 / (3.0 * support_in_h);
+            let length = n as f64 * 0.1;
+            let text = format!(
+                "[simulation]\ndimensions = 2\nspacing = 0.1\nend_time = 0.1\n\
+                 output_interval = 0.05\ngravity = [0.0, 0.0]\n\n\
+                 [[fluid]]\nname = \"water\"\ndensity = 1000.0\nviscosity = 1e-3\n\n\
+                 [[fluid_block]]\nfluid = \"water\"\nmin = [0.0, 0.0]\nmax = [{length:?}, {length:?}]\n\n\
+                 [container]\nmin = [0.0, 0.0]\nmax = [{length:?}, {length:?}]\n\
+                 periodic = [true, true]\n\n\
+                 [solver]\nkernel = \"{kernel}\"\nh_over_dx = {h_over_dx:?}\n"
+            );
+            match isph::Scene::parse(&text, Path::new("scene.toml")) {
+                Ok(scene) => {
+                    isph::Simulation::<2>::new(&scene).unwrap();
+                }
+                Err(e) => assert!(
+                    e.to_string().contains("container.periodic")
+                        || e.to_string().contains("solver.h_over_dx"),
+                    "n = {n}, {kernel}: {e}"
+                ),
+            }
+        }
+    }
+}
+
+/// A particles.h5 whose datasets disagree in length (edited, or cut short) is refused by the
+/// readers with the file, the frame and the dataset named, not a panic.
+#[test]
+fn a_frame_with_datasets_of_unequal_length_is_refused() {
+    let dir = TempDir::new("bad-frame");
+    let (path, out) = scene_in(dir.path(), &good());
+    let (path, out_s) = (path.to_str().unwrap(), out.to_str().unwrap());
+    assert!(isph(&["run", path, "--out", out_s, "-q"]).status.success());
+    {
+        let file = hdf5::File::open_rw(out.join("particles.h5")).unwrap();
+        let frame = file.group("frame_000001").unwrap();
+        frame.unlink("pressure").unwrap();
+        frame
+            .new_dataset_builder()
+            .with_data(&[0.0f64; 3])
+            .create("pressure")
+            .unwrap();
+    }
+    let png = dir.path().join("frame.png");
+    for args in [
+        vec!["render", out_s, "-o", png.to_str().unwrap()],
+        vec!["surface", out_s, "--frames", "last"],
+    ] {
+        let o = isph(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_refused(
+            o.status.code().unwrap_or(-1),
+            &stderr,
+            &["particles.h5", "frame 1", "but 3 in `pressure`"],
+        );
+    }
+}
+
+/// A stop time beyond `end_time` (`--until`) is held to what `end_time` is: the frames it
+/// would write, and a prescribed body's path up to it (here a box swung along x that stays in
+/// the tank for the scene's 0.01 s and hits the right wall at t = 0.25 s).
+#[test]
+fn a_stop_time_beyond_end_time_is_validated_as_end_time() {
+    let dir = TempDir::new("bad-until");
+    let (code, stderr) = run_text(dir.path(), &good(), &["--until", "1e4"]);
+    assert_refused(
+        code,
+        &stderr,
+        &["simulation.output_interval", "frames", "--until"],
+    );
+    let swung = format!(
+        "{}\n[[body]]\nshape = \"box\"\nmin = [0.25, 0.22]\nmax = [0.29, 0.26]\ndensity = 1000.0\n\
+         motion = \"prescribed\"\n\n[body.trajectory]\nperiod = 1.0\namplitude = [0.12, 0.0]\n",
+        good()
+    );
+    let (code, stderr) = run_text(dir.path(), &swung, &["--until", "0.5"]);
+    assert_refused(
+        code,
+        &stderr,
+        &["body[0].trajectory", "out of the container", "--until"],
+    );
+    assert!(!dir.path().join("out").exists());
+    let (code, stderr) = run_text(dir.path(), &swung, &["--until", "0.02"]);
+    assert_eq!(code, 0, "{stderr}");
 }

@@ -69,6 +69,7 @@ fn bench_writes_one_csv_row_per_point() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{stderr}");
     let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(!dir.path().join("bench.csv.partial").exists());
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(header, COLUMNS);
@@ -142,4 +143,25 @@ fn bench_refuses_bad_sizes_threads_and_an_unwritable_csv() {
             "{args:?} measured before refusing: {stderr}"
         );
     }
+}
+
+/// A bench that fails leaves a CSV file of that name as it was: the rows go to FILE.partial
+/// until every point is measured.
+#[test]
+fn a_failed_bench_keeps_an_existing_csv() {
+    let dir = TempDir::new("bench-keep");
+    let csv = dir.path().join("bench.csv");
+    std::fs::write(&csv, "an earlier bench\n").unwrap();
+    let o = bench(&[
+        "--sizes",
+        "1e13",
+        "--threads",
+        "1",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "an earlier bench\n");
 }

@@ -585,6 +585,26 @@ fn a_directory_resumes_from_its_newest_valid_checkpoint() {
     );
 }
 
+/// A newer checkpoint this isph cannot read but another could (here of a newer format) is a
+/// good run's state: a directory's resume refuses to continue from an older one, which would
+/// delete it, and changes nothing.
+#[test]
+fn a_directory_resume_keeps_a_newer_checkpoint_of_a_newer_format() {
+    let dir = TempDir::new("ckpt-newer-format");
+    let base = base_run(dir.path());
+    let newest = newest_checkpoint(&base);
+    let mut bytes = std::fs::read(&newest).unwrap();
+    bytes[8..12].copy_from_slice(&99u32.to_ne_bytes());
+    std::fs::write(&newest, bytes).unwrap();
+    let before = snapshot(&base);
+    let o = isph(&["resume", base.to_str().unwrap(), "--until", "0.04", "-q"]);
+    assert_refused(&o, &["format version 99", "newer than", "move it out of"]);
+    assert!(
+        snapshot(&base) == before,
+        "a refused resume changed the run's files"
+    );
+}
+
 #[test]
 fn sigterm_stops_a_run_with_a_checkpoint_it_resumes_from() {
     let dir = TempDir::new("ckpt-sigterm");
@@ -741,8 +761,15 @@ fn a_run_resumed_with_other_probes_keeps_the_old_readings_aside() {
     let text = std::fs::read_to_string(&file).unwrap();
     std::fs::write(&file, text.replace("name = \"back\"", "name = \"rear\"")).unwrap();
     let step = final_state::<2>(&out).0;
+    // A file set aside at this step before (the probes changed twice) is not replaced.
+    let earlier = out.join(format!("probes_replaced_at_step_{step}.csv"));
+    std::fs::write(&earlier, "set aside before\n").unwrap();
     let summary = resume_until(&out, end);
-    let aside = out.join(format!("probes_replaced_at_step_{step}.csv"));
+    assert_eq!(
+        std::fs::read_to_string(earlier).unwrap(),
+        "set aside before\n"
+    );
+    let aside = out.join(format!("probes_replaced_at_step_{step}_2.csv"));
     assert_eq!(std::fs::read_to_string(aside).unwrap(), before);
     let (columns, rows) = isph::io::probes::read(&out).unwrap();
     assert_eq!(columns, ["time", "rear", "probe_2_x", "probe_2_y"]);

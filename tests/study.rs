@@ -170,6 +170,16 @@ fn bad_study_files_are_refused_with_the_file_and_key_named() {
             format!("scene = \"{scene}\"\nmeasure = \"hydrostatic\"\n[grid]\n\"simulation.spacing\" = [-0.1]\n"),
             &["`grid.\"simulation.spacing\"`", "must be a positive number"],
         ),
+        (
+            "a grid of more points than a study runs",
+            format!(
+                "scene = \"{scene}\"\nmeasure = \"hydrostatic\"\n[grid]\n{}",
+                (0..8)
+                    .map(|k| format!("\"effects.key{k}\" = [{}]\n", vec!["1"; 30].join(", ")))
+                    .collect::<String>()
+            ),
+            &["`grid`", "6.561e11 points", "more than the 10000"],
+        ),
     ];
     for (what, text, expected) in cases {
         let path = dir.path().join("bad.toml");

@@ -91,6 +91,22 @@ pub enum CheckpointError {
     Mismatch { path: PathBuf, what: String },
 }
 
+impl CheckpointError {
+    /// Whether the file itself is damaged (cut short, overwritten, corrupted), as opposed to a
+    /// sound checkpoint this isph cannot read: of a newer format, of the other byte order, of
+    /// other particles, or behind an error of the file system.
+    pub fn is_damage(&self) -> bool {
+        matches!(
+            self,
+            CheckpointError::Truncated { .. }
+                | CheckpointError::WrongMagic { .. }
+                | CheckpointError::UnknownVersion { .. }
+                | CheckpointError::BadChecksum { .. }
+                | CheckpointError::Malformed { .. }
+        )
+    }
+}
+
 /// How the elements of an array are stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum ElementType {

@@ -332,6 +332,24 @@ impl FrameReader {
                 free_surface: g.dataset("free_surface")?.read_raw()?,
             })
         };
-        read().map_err(|e| self.error(e))
+        let frame = read().map_err(|e| self.error(e))?;
+        let n = frame.kind.len();
+        let lengths = [
+            ("position", frame.position.len()),
+            ("velocity", frame.velocity.len()),
+            ("pressure", frame.pressure.len()),
+            ("density", frame.density.len()),
+            ("fluid", frame.fluid.len()),
+            ("free_surface", frame.free_surface.len()),
+        ];
+        if let Some((name, len)) = lengths.into_iter().find(|&(_, len)| len != n) {
+            return Err(OutputError::Malformed {
+                path: self.path.clone(),
+                what: format!(
+                    "frame {index} holds {n} particles in `kind` but {len} in `{name}`: not a frame isph wrote, or one cut short"
+                ),
+            });
+        }
+        Ok(frame)
     }
 }

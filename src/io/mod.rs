@@ -89,12 +89,13 @@ pub fn prepare_output_dir(dir: &Path, overwrite: bool) -> Result<(), OutputError
         source,
     };
     std::fs::create_dir_all(dir).map_err(dir_error)?;
-    // Surfaces and probes belong to the run they were taken from: a new run replaces them only
+    // Surfaces, probes and bodies.csv belong to the run they were taken from: a new run replaces them only
     // when told.
     let others = [
         surface_files::FILE_NAME,
         surface_files::INDEX_NAME,
         probes::FILE_NAME,
+        bodies_csv::FILE_NAME,
     ];
     for file in RUN_FILES.into_iter().chain(others) {
         if dir.join(file).exists() {

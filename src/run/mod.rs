@@ -129,7 +129,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<RunSummary, RunError> {
 }
 
 fn run_in<const D: usize>(scene: &Scene, opts: &RunOptions) -> Result<RunSummary, RunError> {
-    scene.check_tables_cover(opts.until.unwrap_or(scene.end_time))?;
+    scene.check_stop_time(opts.until.unwrap_or(scene.end_time))?;
     let sim = Simulation::<D>::new(scene)?;
     prepare_output_dir(&opts.out, opts.overwrite)?;
     let output = Output {

@@ -46,6 +46,12 @@ pub enum ResumeError {
     NoCheckpoint { dir: PathBuf },
     #[error("{dir} holds no valid checkpoint: {}", reasons.join("; "))]
     NoValidCheckpoint { dir: PathBuf, reasons: Vec<String> },
+    #[error("{reason}. It is newer than {older}, which a resume of {dir} would continue from and would delete it: resume with an isph that reads it, or move it out of {dir} to continue from the older one")]
+    NewerUnreadable {
+        dir: PathBuf,
+        older: PathBuf,
+        reason: String,
+    },
     #[error("{path} is not in the `{DIR_NAME}` folder of a run's output directory, so the run it continues cannot be found; move it back to OUT/{DIR_NAME}/")]
     OutsideRun { path: PathBuf },
     #[error("cannot load the scene of checkpoint {checkpoint}: {source}{}", if *given { "" } else { "; pass --scene FILE if the scene has moved" })]
@@ -108,10 +114,21 @@ pub fn locate(target: &Path) -> Result<Located, ResumeError> {
         source,
     })?;
     match newest.valid {
-        Some(checkpoint) => Ok(Located {
-            checkpoint,
-            skipped: newest.rejected,
-        }),
+        Some(checkpoint) => {
+            // A damaged checkpoint is skipped (and deleted with the run's future); one this isph
+            // cannot read but another could is a good run's state, and is kept.
+            if let Some(e) = newest.rejected.iter().find(|e| !e.is_damage()) {
+                return Err(ResumeError::NewerUnreadable {
+                    dir: target.to_owned(),
+                    older: checkpoint.path().to_owned(),
+                    reason: e.to_string(),
+                });
+            }
+            Ok(Located {
+                checkpoint,
+                skipped: newest.rejected,
+            })
+        }
         None if newest.rejected.is_empty() => Err(ResumeError::NoCheckpoint {
             dir: target.to_owned(),
         }),
@@ -150,7 +167,7 @@ pub(crate) fn check(checkpoint: &Checkpoint, opts: &ResumeOptions) -> Result<Che
     let out = output_dir(&path)?;
     let scene = load_scene(checkpoint, opts)?;
     let end = opts.until.unwrap_or(scene.end_time);
-    scene.check_tables_cover(end)?;
+    scene.check_stop_time(end)?;
     if end <= state.time {
         return Err(ResumeError::NothingToDo {
             checkpoint: path,
@@ -335,7 +352,7 @@ fn continue_probes(
         ProbesFile::Start { set_aside } => {
             if set_aside {
                 let path = out.join(probes::FILE_NAME);
-                let aside = out.join(format!("probes_replaced_at_step_{step}.csv"));
+                let aside = free_name(out, &format!("probes_replaced_at_step_{step}"), "csv");
                 std::fs::rename(&path, &aside).map_err(|source| OutputError::Write {
                     path: aside.clone(),
                     source,
@@ -352,6 +369,18 @@ fn continue_probes(
             ProbesWriter::create(out, &scene.probes).map(Some)
         }
     }
+}
+
+/// `dir`/`stem`.`extension`, or the first of `stem`_2, `stem`_3, … not taken: a file set
+/// aside never replaces one set aside before (probes changed twice at one step).
+fn free_name(dir: &Path, stem: &str, extension: &str) -> PathBuf {
+    (1..)
+        .map(|k| match k {
+            1 => dir.join(format!("{stem}.{extension}")),
+            k => dir.join(format!("{stem}_{k}.{extension}")),
+        })
+        .find(|path| !path.exists())
+        .expect("some name is free")
 }
 
 /// The run's surface.h5 cut back to its first `frames` frames; a new one if it has none, or if

@@ -116,10 +116,20 @@ fn binary_stl(bytes: &[u8]) -> Result<TriangleMesh, String> {
     let f = |at: usize| {
         f32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]) as f64
     };
-    let vertices = (0..count)
+    let vertices: Vec<[f64; 3]> = (0..count)
         .flat_map(|t| (0..3).map(move |v| 84 + 50 * t + 12 + 12 * v))
         .map(|at| [f(at), f(at + 4), f(at + 8)])
         .collect();
+    if let Some(k) = vertices
+        .iter()
+        .position(|v| !v.iter().all(|x| x.is_finite()))
+    {
+        return Err(format!(
+            "facet {}: a vertex needs three finite numbers, not {:?}",
+            k / 3 + 1,
+            vertices[k]
+        ));
+    }
     Ok(welded(vertices))
 }
 

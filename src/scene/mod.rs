@@ -5,6 +5,7 @@ mod bodies;
 mod effects;
 mod file;
 mod mesh_file;
+pub mod overrides;
 mod probes;
 mod surface;
 pub mod trajectory;
@@ -96,6 +97,12 @@ impl SolverSettings {
     pub fn support_in_dx(&self) -> f64 {
         self.kernel.support_in_h() * self.h_over_dx
     }
+
+    /// The kernel's support radius [m] at particle spacing `spacing`, with the bits
+    /// `Kernel::support` gives it.
+    pub fn support(&self, spacing: f64) -> f64 {
+        self.kernel.support_in_h() * (self.h_over_dx * spacing)
+    }
 }
 
 impl Default for SolverSettings {
@@ -173,6 +180,9 @@ impl Block {
 #[derive(Debug, Clone)]
 pub struct Scene {
     pub path: PathBuf,
+    /// The text the scene was parsed from: a stop time beyond `end_time` is validated on it
+    /// (`check_stop_time`).
+    pub text: String,
     pub name: String,
     pub dimensions: usize,
     pub spacing: f64,
@@ -206,45 +216,60 @@ pub struct Scene {
     pub bodies: Vec<Body>,
 }
 
-impl Scene {
-    /// Refuses a stop time `end` (`--until`) past the end of a motion table, the container's
-    /// or a prescribed body's before its release: after its last row a table holds its last
-    /// pose, at rest, and a run past it would stop the motion dead. Validation checks the
-    /// tables against `end_time`.
-    pub fn check_tables_cover(&self, end: f64) -> Result<(), SceneError> {
-        let container = self
-            .container_motion
-            .iter()
-            .map(|t| ("container.trajectory".to_string(), t, end));
-        let bodies = self
-            .bodies
-            .iter()
-            .enumerate()
-            .filter_map(|(k, b)| match &b.motion {
-                BodyMotion::Prescribed(t) => Some((
-                    format!("body[{k}].trajectory"),
-                    t,
-                    b.release.map_or(end, |r| r.min(end)),
-                )),
-                _ => None,
-            });
-        for (key, t, until) in container.chain(bodies) {
-            if let trajectory::Path::Table { file, rows } = &t.path {
-                let last = rows.last().map_or(0.0, |r| r.time);
-                if last < until {
-                    return Err(SceneError::Invalid {
-                        path: self.path.clone(),
-                        line: None,
-                        key: format!("{key}.table"),
-                        message: format!(
-                            "= \"{}\" ends at {last:?} s, before the stop time {end:?} s: the table must cover the whole run (extend it, or stop earlier)",
-                            file.display()
-                        ),
-                    });
-                }
-            }
+/// A TOML error of `text` in one line: where it is and what is wrong, without the source
+/// line and caret that `toml` draws under it (a long line would be echoed whole).
+pub fn syntax_message(text: &str, e: &toml::de::Error) -> String {
+    let what = e
+        .message()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(": ");
+    match e.span() {
+        Some(span) => {
+            let before = text.get(..span.start).unwrap_or(text);
+            let line = before.matches('\n').count() + 1;
+            let column = before[before.rfind('\n').map_or(0, |k| k + 1)..]
+                .chars()
+                .count()
+                + 1;
+            format!("TOML parse error at line {line}, column {column}: {what}")
         }
-        Ok(())
+        None => format!("TOML parse error: {what}"),
+    }
+}
+
+impl Scene {
+    /// Refuses a stop time `end` (`--until`) beyond `end_time` that the scene's validation
+    /// would refuse as its `end_time`: more frames than a run writes, a motion table that ends
+    /// before it (after its last row a table holds its last pose, at rest, and a run past it
+    /// would stop the motion dead), a prescribed body's path that leaves the container or runs
+    /// into an obstacle before it. The scene's text is validated again with `end_time = end`.
+    pub fn check_stop_time(&self, end: f64) -> Result<(), SceneError> {
+        if end <= self.end_time {
+            return Ok(());
+        }
+        let setting = ("simulation.end_time".to_string(), toml::Value::Float(end));
+        let text = overrides::apply(&self.text, &[setting]).map_err(|e| SceneError::Syntax {
+            path: self.path.clone(),
+            message: e.to_string(),
+        })?;
+        match Scene::parse(&text, &self.path) {
+            Ok(_) => Ok(()),
+            Err(SceneError::Invalid {
+                path,
+                line,
+                key,
+                message,
+            }) => Err(SceneError::Invalid {
+                path,
+                line,
+                key,
+                message: format!("{message} (with the stop time {end:?} s of `--until`)"),
+            }),
+            Err(e) => Err(e),
+        }
     }
 
     /// Reads, parses and validates a scene file.
@@ -260,7 +285,7 @@ impl Scene {
     pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         let file: file::SceneFile = toml::from_str(text).map_err(|e| SceneError::Syntax {
             path: path.to_owned(),
-            message: e.to_string().trim_end().to_owned(),
+            message: syntax_message(text, &e),
         })?;
         validate::Validator { text, path }.scene(file)
     }
@@ -268,6 +293,19 @@ impl Scene {
     /// Number of dummy wall layers that fill the kernel support.
     pub fn wall_layers(&self) -> usize {
         (self.solver.support_in_dx() - 1e-9).ceil() as usize
+    }
+
+    /// Lattice points of the container and its wall layers: the points `fill::build` visits,
+    /// and the extent of the cell list and the multigrid's first level.
+    pub fn container_points(&self) -> f64 {
+        let layers = self.wall_layers() as f64;
+        let c = &self.container;
+        (0..self.dimensions)
+            .map(|d| {
+                let walls = if self.periodic[d] { 0.0 } else { 2.0 * layers };
+                ((c.max[d] - c.min[d]) / self.spacing).ceil() + 1.0 + walls
+            })
+            .product()
     }
 
     /// At least as many particles as `fill::build` makes, fluid and wall, counted without making
@@ -321,7 +359,7 @@ impl Scene {
 
     /// A hash of everything in the validated scene that shapes the trajectory: xxh3-64 of its
     /// Debug rendering (which prints every f64 so that it reads back to the same bits), with the
-    /// fields that cannot change a step blanked: the file's path, the run's name, `end_time`
+    /// fields that cannot change a step blanked: the file's path and text, the run's name, `end_time`
     /// (`--until` overrides it anyway), the checkpoint cadence, the surface output and the
     /// probes (what a run records, read off the particles after each step, never fed back into
     /// them). So comments, formatting and defaults written out do not count, and a run can be
@@ -330,6 +368,7 @@ impl Scene {
     pub fn content_hash(&self) -> u64 {
         let trajectory = Scene {
             path: PathBuf::new(),
+            text: String::new(),
             name: String::new(),
             end_time: 0.0,
             checkpoint: CheckpointSettings::default(),

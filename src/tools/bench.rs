@@ -466,25 +466,40 @@ fn min_max(v: &[f64]) -> (f64, f64) {
     (min, max)
 }
 
-/// The CSV file, one row written (and flushed) per point as it comes, so the points measured
-/// before a failure are kept.
+/// The CSV file, one row written (and flushed) per point as it comes into `FILE.partial`,
+/// which takes the name FILE once every point is measured: the points measured before a
+/// failure are kept there, and a FILE already on disk is replaced only by a finished bench.
 struct CsvOut {
     path: PathBuf,
+    partial: PathBuf,
     out: BufWriter<File>,
     header_written: bool,
 }
 
 impl CsvOut {
-    /// Creates the file at once, so an unwritable path fails before any measurement.
+    /// Creates `FILE.partial` at once, so an unwritable path fails before any measurement.
     fn create(path: &Path) -> Result<Self, BenchError> {
-        let file = File::create(path).map_err(|source| BenchError::Csv {
-            path: path.to_owned(),
+        let mut partial = path.as_os_str().to_owned();
+        partial.push(".partial");
+        let partial = PathBuf::from(partial);
+        let file = File::create(&partial).map_err(|source| BenchError::Csv {
+            path: partial.clone(),
             source,
         })?;
         Ok(Self {
             path: path.to_owned(),
+            partial,
             out: BufWriter::new(file),
             header_written: false,
+        })
+    }
+
+    /// Gives the finished file its name.
+    fn finish(self) -> Result<(), BenchError> {
+        drop(self.out);
+        std::fs::rename(&self.partial, &self.path).map_err(|source| BenchError::Csv {
+            path: self.path,
+            source,
         })
     }
 
@@ -502,7 +517,7 @@ impl CsvOut {
             .write_all(text.as_bytes())
             .and_then(|_| self.out.flush())
             .map_err(|source| BenchError::Csv {
-                path: self.path.clone(),
+                path: self.partial.clone(),
                 source,
             })
     }
@@ -550,6 +565,9 @@ pub fn run(
             }
             rows.push(row);
         }
+    }
+    if let Some(csv) = csv {
+        csv.finish()?;
     }
     Ok(rows)
 }

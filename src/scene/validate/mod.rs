@@ -35,6 +35,11 @@ const MAX_PERTURBATION: f64 = 0.25;
 /// `isph bench` measures on the 3D dam break from 10⁴ to 10⁶ particles (540–562 B;
 /// docs/performance.md, "Memory per particle").
 const PEAK_BYTES_PER_PARTICLE: f64 = 650.0;
+/// Bytes a run holds per lattice point of the container (walls included) whether water fills
+/// it or not: the fill's map of what each point holds, the cell list's starts and the
+/// multigrid's first level span the whole container. 10 B in 2D and about 14 B in 3D measured
+/// (peak RSS of mostly empty containers at 1.6e7 and 8e6 points, 2026-12-06).
+const BYTES_PER_CONTAINER_POINT: f64 = 24.0;
 
 /// Checks a parsed file and turns it into a `Scene`, locating bad keys in the source text.
 pub(super) struct Validator<'a> {
@@ -333,6 +338,7 @@ impl Validator<'_> {
         };
         let scene = Scene {
             path: self.path.to_owned(),
+            text: self.text.to_owned(),
             name,
             dimensions: dims,
             spacing: s.spacing,
@@ -362,31 +368,52 @@ impl Validator<'_> {
     }
 
     /// Refuses a scene whose particles could not be held: more than the u32 indices of the
-    /// cell sort reach, or more memory at the peak of a run (`PEAK_BYTES_PER_PARTICLE`) than
-    /// the machine has in all (not what is free now: a study measures its finished points while
-    /// others run).
+    /// cell sort reach, or more memory at the peak of a run than the machine has in all (not
+    /// what is free now: a study measures its finished points while others run).
     fn fits_in_memory(&self, scene: &Scene) -> Result<(), SceneError> {
-        let particles = scene.particle_bound();
-        let key = "simulation.spacing";
-        let what = format!(
-            "= {:?} puts up to {particles:.3e} particles in the container and its walls",
-            scene.spacing
-        );
+        let (particles, points) = (scene.particle_bound(), scene.container_points());
+        self.memory_holds(
+            "simulation.spacing",
+            &format!(
+                "= {:?} puts up to {particles:.3e} particles and {points:.3e} lattice points in the container and its walls",
+                scene.spacing
+            ),
+            particles,
+            points,
+        )
+    }
+
+    /// Refuses `particles` particles over a container of `points` lattice points (`what` says
+    /// where they come from, `key` names the key): more than u32 indices reach, or more memory
+    /// than the machine has in all, at `PEAK_BYTES_PER_PARTICLE` per particle and
+    /// `BYTES_PER_CONTAINER_POINT` per lattice point of the container.
+    fn memory_holds(
+        &self,
+        key: &str,
+        what: &str,
+        particles: f64,
+        points: f64,
+    ) -> Result<(), SceneError> {
         self.check(
-            particles < u32::MAX as f64,
+            particles.max(points) < u32::MAX as f64,
             key,
             format!("{what}, more than the {} isph can index", u32::MAX),
         )?;
-        let needed = particles * PEAK_BYTES_PER_PARTICLE;
+        let needed = particles * PEAK_BYTES_PER_PARTICLE + points * BYTES_PER_CONTAINER_POINT;
         // The machine's memory in all (MemTotal); no check where /proc/meminfo cannot be read.
         if let Ok(memory) = crate::math::memory::proc_bytes("/proc/meminfo", "MemTotal") {
             let memory = memory as f64;
             const GIB: f64 = (1u64 << 30) as f64;
+            let container = if points > 0.0 {
+                format!(" and {BYTES_PER_CONTAINER_POINT} B per lattice point of the container")
+            } else {
+                String::new()
+            };
             self.check(
                 needed <= memory,
                 key,
                 format!(
-                    "{what}: about {:.1} GiB at {PEAK_BYTES_PER_PARTICLE} B/particle, more than the {:.1} GiB of memory this machine has",
+                    "{what}: about {:.1} GiB at {PEAK_BYTES_PER_PARTICLE} B per particle{container}, more than the {:.1} GiB of memory this machine has",
                     needed / GIB,
                     memory / GIB
                 ),
@@ -481,7 +508,7 @@ impl Validator<'_> {
                 flags.len()
             ),
         )?;
-        let support = solver.support_in_dx() * spacing;
+        let support = solver.support(spacing);
         for d in (0..dims).filter(|&d| flags[d]) {
             let length = container.max[d] - container.min[d];
             let spacings = length / spacing;
@@ -490,10 +517,12 @@ impl Validator<'_> {
                 key,
                 format!("axis {d} is periodic, so its length {length:?} m must be a whole number of spacings ({spacing:?} m); it is {spacings:.4} spacings"),
             )?;
+            // Above three supports by more than rounding: the cell list divides the period
+            // into cells of a third or a quarter of a support and needs three supports' worth.
             self.check(
-                length >= 3.0 * support,
+                length >= 3.0 * support * (1.0 + 1e-9),
                 key,
-                format!("axis {d} is periodic, so its length {length:?} m must be at least three kernel supports (3 × {:.4} m)", support),
+                format!("axis {d} is periodic, so its length {length:?} m must be longer than three kernel supports (3 × {support:?} m): lengthen the axis or lower `solver.h_over_dx`"),
             )?;
         }
         Ok(flags.to_vec())
@@ -752,6 +781,19 @@ impl Validator<'_> {
                     container.min,
                     container.max
                 ),
+            )?;
+            let points: f64 = (0..dims)
+                .map(|d| ((bounds.max[d] - bounds.min[d]) / s.spacing).ceil() + 1.0)
+                .product();
+            self.memory_holds(
+                &format!("{key}.shape"),
+                &format!(
+                    "the {} spans up to {points:.3e} lattice points of the spacing {:?} m",
+                    shape.name(dims),
+                    s.spacing
+                ),
+                points,
+                0.0,
             )?;
             let lattice = lattice_points_in(&bounds, container, s.spacing);
             // The body's particles at t = 0: its lattice points, found once for every check.

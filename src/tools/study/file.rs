@@ -2,9 +2,8 @@
 //! Cartesian product are the study's points. Unknown keys are errors; every error names the
 //! study file and the key. Each point's scene is built and validated here, before any runs.
 
-use super::overrides;
 use super::StudyError;
-use crate::scene::Scene;
+use crate::scene::{overrides, Scene};
 use crate::tools::validation::Case;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -19,6 +18,9 @@ struct StudyFile {
     #[serde(default)]
     grid: BTreeMap<String, Vec<toml::Value>>,
 }
+
+/// Points a study holds at most: a grid beyond it is a typo, not a study (each point is a run).
+const MAX_POINTS: usize = 10_000;
 
 /// One combination of the grid's values.
 #[derive(Clone, Debug)]
@@ -51,7 +53,7 @@ impl Study {
         })?;
         let file: StudyFile = toml::from_str(&text).map_err(|e| StudyError::Syntax {
             path: path.to_owned(),
-            message: e.to_string().trim_end().to_owned(),
+            message: crate::scene::syntax_message(&text, &e),
         })?;
         let invalid = |key: &str, message: String| StudyError::Invalid {
             path: path.to_owned(),
@@ -85,6 +87,20 @@ impl Study {
         })?;
         Scene::parse(&scene_text, &scene_path)
             .map_err(|e| invalid("scene", format!("does not load: {e}")))?;
+        let count: f64 = file.grid.values().map(|v| v.len() as f64).product();
+        if count > MAX_POINTS as f64 {
+            return Err(invalid(
+                "grid",
+                format!(
+                    "holds {count:.3e} points ({}), more than the {MAX_POINTS} a study runs: split it into studies over fewer keys or values",
+                    file.grid
+                        .iter()
+                        .map(|(k, v)| format!("{} of \"{k}\"", v.len()))
+                        .collect::<Vec<_>>()
+                        .join(" × ")
+                ),
+            ));
+        }
         let grid = product(&file.grid);
         for (key, values) in &file.grid {
             check_values(key, values).map_err(|m| invalid(&format!("grid.\"{key}\""), m))?;

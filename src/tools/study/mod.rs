@@ -1,6 +1,6 @@
 //! `isph study STUDY.toml`: accuracy against cost over a grid of settings (docs/study-format.md).
 //!
-//! Each point of the grid is the study's scene with the point's settings written in (`overrides`),
+//! Each point of the grid is the study's scene with the point's settings written in (`scene::overrides`),
 //! run by a child `isph run` (so its wall time and peak memory are its own, see
 //! [`crate::tools::child`]), measured by [`crate::tools::validation::measure`] and recorded as one
 //! row of `OUT/study.csv` (`table`). A point with a row is never run again, and `claim` keeps two
@@ -9,7 +9,6 @@
 
 pub mod claim;
 pub mod file;
-pub mod overrides;
 pub mod plot;
 pub mod table;
 
