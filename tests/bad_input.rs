@@ -437,6 +437,7 @@ fn each_bad_trajectory_is_refused_with_its_key() {
         (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\ntable = \"short.csv\""), &["body[0].trajectory.table", "before `simulation.end_time`"]),
         (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\ntable = \"missing.csv\""), &["body[0].trajectory.table", "cannot read"]),
         (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 1.0"), &["body[0].trajectory", "gives no motion"]),
+        (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 1e-300\namplitude = [0.01, 0.0]"), &["body[0].trajectory.period", "overflow"]),
         (format!("{circle}\nrelease = 1.0"), &["body[0].release", "fixed or prescribed"]),
         (format!("{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 0.04\namplitude = [0.3, 0.0]"), &["body[0].trajectory", "out of the container", "walls do not yield"]),
         (format!("[[obstacle]]\nmin = [0.25, 0.05]\nmax = [0.3, 0.15]\n\n{circle}\nmotion = \"prescribed\"\n[body.trajectory]\nperiod = 0.04\namplitude = [0.2, 0.0]"), &["body[0].trajectory", "into obstacle[0]", "does not yield"]),

@@ -30,6 +30,18 @@ impl Validator<'_> {
                     &format!("{key}.angle"),
                     "must be a finite number [degrees]",
                 )?;
+                // The motion's acceleration amplitude, (2π/T)² times the largest amplitude: a
+                // period so short that it overflows gives no motion a step could follow.
+                let omega = 2.0 * std::f64::consts::PI / period;
+                let largest = amplitude
+                    .iter()
+                    .map(|a| a.abs())
+                    .fold(angle.to_radians().abs(), f64::max);
+                self.check(
+                    (omega * omega * largest).is_finite(),
+                    &format!("{key}.period"),
+                    format!("= {period:?} s makes the motion's acceleration (2π/period)² × amplitude overflow: give a period a time step can follow"),
+                )?;
                 Path::Sinusoid {
                     amplitude: std::array::from_fn(|d| amplitude.get(d).copied().unwrap_or(0.0)),
                     angle: angle.to_radians(),
