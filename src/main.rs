@@ -111,7 +111,7 @@ enum Command {
         /// Frames: `all`, `last`, or numbers and inclusive ranges, comma-separated (`0,10..20`).
         #[arg(long, default_value = "all")]
         frames: String,
-        /// Density kernel: rectangular, quadric, quartic or gaussian (Eq. 28–31).
+        /// Density kernel: rectangular, quadric, quartic or gaussian (Eq. 28–31) [default: quartic].
         #[arg(long)]
         kernel: Option<String>,
         /// Kernel radius, in particle spacings [default: the kernel's own, docs/surface.md].

@@ -176,6 +176,12 @@ impl Block {
     }
 }
 
+/// Bytes a run holds per lattice point of the container (walls included) whether water fills
+/// it or not: the fill's map of what each point holds, the cell list's starts and the
+/// multigrid's first level span the whole container. 10 B in 2D and about 14 B in 3D measured
+/// (peak RSS of mostly empty containers at 1.6e7 and 8e6 points, 2026-12-06).
+pub const BYTES_PER_CONTAINER_POINT: f64 = 24.0;
+
 /// A validated scene.
 #[derive(Debug, Clone)]
 pub struct Scene {

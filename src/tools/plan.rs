@@ -4,7 +4,7 @@
 //! the plan and the step cannot disagree.
 
 use crate::math::kernel::KernelKind;
-use crate::scene::{BodyMotion, Effects, Scene};
+use crate::scene::{BodyMotion, Effects, Scene, BYTES_PER_CONTAINER_POINT};
 use crate::scene::{CubeRule, Probe, SurfaceSettings};
 use crate::simulation::{NoFluid, Simulation};
 use std::fmt;
@@ -48,6 +48,9 @@ pub struct Plan {
     pub stages: Vec<PlannedStage>,
     /// `[[body]]`, each with its particles and the fluid lattice points it displaced.
     pub bodies: Vec<PlannedBody>,
+    /// Lattice points of the container and its walls (`Scene::container_points`): the extent
+    /// of the per-cell arrays.
+    pub container_points: f64,
 }
 
 /// One rigid body as the plan lists it.
@@ -132,6 +135,7 @@ impl Plan {
             state_bytes_per_particle: state.iter().map(|(_, a)| a.element_bytes()).sum(),
             stages,
             bodies,
+            container_points: scene.container_points(),
         })
     }
 
@@ -270,9 +274,11 @@ impl fmt::Display for Plan {
         }
         write!(
             f,
-            "memory: {} B/particle, {:.2} MiB for the particle arrays (plus per-cell arrays: the cell list and the multigrid levels); the workspace of a step holds the fluid particles only",
+            "memory: {} B/particle, {:.2} MiB for the particle arrays, plus the per-cell arrays over the container's {:.3e} lattice points (the fill's map, the cell list, the multigrid levels: at most {BYTES_PER_CONTAINER_POINT} B each, {:.2} MiB); the workspace of a step holds the fluid particles only",
             self.bytes_per_particle(),
-            mib(self.bytes())
+            mib(self.bytes()),
+            self.container_points,
+            self.container_points * BYTES_PER_CONTAINER_POINT / (1u64 << 20) as f64
         )
     }
 }

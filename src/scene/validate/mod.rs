@@ -17,6 +17,7 @@ use super::{
     SurfaceRequest, SurfaceSettings,
 };
 use crate::math::kernel::KernelKind;
+use crate::scene::BYTES_PER_CONTAINER_POINT;
 use std::path::Path;
 
 /// Frames a scene may ask for, at most (end_time / output_interval).
@@ -32,14 +33,9 @@ const PERTURBATION_WITHOUT_BODY_FORCE: f64 = 0.1;
 const MAX_PERTURBATION: f64 = 0.25;
 
 /// Peak resident memory of a run per particle, walls included, with a margin over the peaks
-/// `isph bench` measures on the 3D dam break from 10⁴ to 10⁶ particles (540–562 B;
+/// `isph bench` measures on the 3D dam break (480 B at 10⁵, 571–575 B at 10⁶ fluid particles;
 /// docs/performance.md, "Memory per particle").
 const PEAK_BYTES_PER_PARTICLE: f64 = 650.0;
-/// Bytes a run holds per lattice point of the container (walls included) whether water fills
-/// it or not: the fill's map of what each point holds, the cell list's starts and the
-/// multigrid's first level span the whole container. 10 B in 2D and about 14 B in 3D measured
-/// (peak RSS of mostly empty containers at 1.6e7 and 8e6 points, 2026-12-06).
-const BYTES_PER_CONTAINER_POINT: f64 = 24.0;
 
 /// Checks a parsed file and turns it into a `Scene`, locating bad keys in the source text.
 pub(super) struct Validator<'a> {
