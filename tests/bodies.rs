@@ -689,9 +689,9 @@ fn a_box_set_sliding_on_the_floor_stops_where_coulomb_friction_stops_it() {
 fn the_sinking_cylinder_keeps_near_the_band_of_its_two_references() {
     // scenes/sinking_cylinder_2d.toml (D/dx = 20): R = 1 m at s = 1.2 held half submerged for
     // 1 s, then let go. Its displacement at T = (t − 1) √(g/R) = 1 … 4 against Fekken (2004)
-    // and Moyo & Greenhow (2000): inside their band widened by 10% of the nearer one (measured
-    // 1.0% beyond it at T = 2 and inside at T = 1, 3, 4; at D/dx = 40, 1.2% beyond at T = 2
-    // and inside at T = 1, 3, 4: docs/bodies.md, "Sinking cylinder").
+    // and Moyo & Greenhow (2000), at the scene's CFL 0.1: inside their band widened by 10% of
+    // the nearer one (the scene's draw inside it at T = 1 … 4; over five draws T = 2 reads
+    // −0.646 to −0.656 against the band [−0.657, −0.649]: docs/bodies.md, "Sinking cylinder").
     let dir = TempDir::new("bodies-sinking-cylinder");
     let scene = crate::common::shipped_scene("sinking_cylinder_2d.toml");
     let release = 1.0;
