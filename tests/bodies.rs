@@ -485,9 +485,10 @@ motion = "fixed"
         .iter()
         .fold(0.0, |m: f64, s| m.max(*s));
     eprintln!("max speed early {early}, late {late}");
+    // Measured: 0.023 m/s over the first tenth, 5.3e-3 m/s over the second half (2026-12-06).
     assert!(
-        late < early,
-        "the water around a fixed body speeds up: {early} → {late} m/s"
+        late < early && late < 0.01,
+        "the water around a fixed body speeds up or keeps moving: {early} → {late} m/s"
     );
 }
 

@@ -30,11 +30,21 @@ fn assert_thread_count_independent(name: &str, scene: &Scene, until: f64, frames
         }
     }
     let bodies = |dir: &TempDir| std::fs::read(dir.path().join("bodies.csv")).ok();
+    assert_eq!(
+        bodies(&dirs[0]).is_some(),
+        !scene.bodies.is_empty(),
+        "{name}: bodies.csv is written exactly when the scene has bodies"
+    );
     assert!(
         bodies(&dirs[0]) == bodies(&dirs[1]),
         "{name}: bodies.csv differs between 1 and 2 threads"
     );
     let probes = |dir: &TempDir| std::fs::read(dir.path().join("probes.csv")).ok();
+    assert_eq!(
+        probes(&dirs[0]).is_some(),
+        !scene.probes.is_empty(),
+        "{name}: probes.csv is written exactly when the scene has probes"
+    );
     assert_eq!(
         probes(&dirs[0]),
         probes(&dirs[1]),

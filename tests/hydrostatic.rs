@@ -11,11 +11,12 @@ fn still_water_has_hydrostatic_pressure_and_no_penetration() {
     let summary = run_scene(&scene, dir.path(), 1.0);
     let last = summary.frames.len() - 1;
     let m = measure(Case::Hydrostatic, &scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
-    // Measured: 2–5e-5 of ρgH at tolerance 1e-6 (docs/accuracy.md, "Hydrostatic tank"), bottom
-    // pressure likewise.
-    assert!(m.error < 0.005, "rms pressure error {} of ρgH", m.error);
+    // Measured: 5.3e-5 of ρgH, the bottom pressure likewise (2026-12-06, the default tolerance
+    // 1e-4; docs/accuracy.md, "Hydrostatic tank").
     let bottom = m.details[0].1;
-    assert!(bottom.abs() < 0.005, "bottom pressure error {bottom}");
+    eprintln!("rms pressure error {:e}, bottom {bottom:e}", m.error);
+    assert!(m.error < 5e-4, "rms pressure error {} of ρgH", m.error);
+    assert!(bottom.abs() < 5e-4, "bottom pressure error {bottom}");
     let kind: Vec<i32> = read_frame(dir.path(), last, "kind");
     let first_kind: Vec<i32> = read_frame(dir.path(), 0, "kind");
     assert_eq!(
@@ -72,16 +73,22 @@ fn a_closed_box_full_of_water_stays_at_rest() {
     let scene = crate::common::scene_from_text(&text);
     let dir = TempDir::new("closed_box");
     let summary = run_scene(&scene, dir.path(), 0.5);
-    // Measured: 2.4e-7 m/s at most (√(gH) = 1.7 m/s).
+    // Measured: 3.2e-5 m/s at most at the default tolerance 1e-4, 2.4e-7 at 1e-6 (√(gH) = 1.7
+    // m/s).
     let fastest = stats_column(dir.path(), "max_speed")
         .into_iter()
         .fold(0.0, f64::max);
+    eprintln!("closed box: max speed {fastest:e}");
     assert!(fastest < 1e-4, "max speed {fastest} m/s");
     // The pressure against depth: a least-squares line through the last frame's fluid.
     let gradient = pressure_gradient(dir.path(), summary.frames.len() - 1, |_, _| true);
-    // Measured: −ρ g to 2e-8.
+    // Measured: −ρ g to 6.6e-6 (2e-8 at the tolerance 1e-6).
+    eprintln!(
+        "closed box gradient {:e}",
+        gradient / (-1000.0 * 9.81) - 1.0
+    );
     assert!(
-        (gradient / (-1000.0 * 9.81) - 1.0).abs() < 1e-3,
+        (gradient / (-1000.0 * 9.81) - 1.0).abs() < 1e-4,
         "dP/dy = {gradient} Pa/m"
     );
 }
@@ -161,15 +168,19 @@ max = [0.5, 0.4]
         .fold(0.0, f64::max);
     assert!(fastest < 1e-3, "{light_density}: max speed {fastest} m/s");
     let last = summary.frames.len() - 1;
-    // Each layer's gradient, away from the side walls: measured within 0.1% of ρ0 g in both
-    // layers at 0.6 s, at either density.
+    // Each layer's gradient, away from the side walls: measured within 1.3e-4 of ρ0 g in both
+    // layers at 0.6 s, at each density.
     for (index, rest_density) in [(0, 1000.0), (1, light_density)] {
         let gradient = pressure_gradient(dir.path(), last, |fluid, x| {
             fluid == index && (x - 0.25).abs() < 0.2
         });
         let expected = -rest_density * 9.81;
+        eprintln!(
+            "layer {index} {light_density}: {:e}",
+            gradient / expected - 1.0
+        );
         assert!(
-            (gradient / expected - 1.0).abs() < 0.02,
+            (gradient / expected - 1.0).abs() < 1e-3,
             "{light_density}, fluid {index}: dP/dy = {gradient} Pa/m against {expected}"
         );
     }
@@ -197,7 +208,8 @@ fn a_fluid_at_a_tenth_of_the_density_of_water_keeps_its_hydrostatic_pressure() {
 /// guards against the layers beside the interface pairing up in an exponential mode, which a
 /// distance to the interface that overreacts to the other fluid's particles moving drives
 /// (`interface::pair_weight`; docs/scene-format.md, "`[[fluid]]`"). Measured over the second
-/// second: 7.6e-5 m/s at most with side walls, 7e-7 periodic.
+/// second: 3.9e-4 m/s at most with side walls, 3.5e-5 periodic (2026-12-06, the default tolerance
+/// 1e-4; 7.6e-5 and 7e-7 at 1e-6).
 fn a_deep_layering_stays_at_rest(periodic: bool, speed_bound: f64) {
     let scene = scene_from_text(&format!(
         "[simulation]\ndimensions = 2\nspacing = 0.0125\nend_time = 2.0\noutput_interval = 0.5\n\
@@ -217,6 +229,7 @@ fn a_deep_layering_stays_at_rest(periodic: bool, speed_bound: f64) {
         .zip(&speed)
         .filter(|(&t, _)| t >= 1.0)
         .fold(0.0, |m: f64, (_, &v)| m.max(v));
+    eprintln!("deep periodic {periodic}: late {late:e}");
     assert!(
         late < speed_bound,
         "periodic {periodic}: {late} m/s in the second second"
@@ -409,7 +422,9 @@ fn the_correction_threshold_is_0_1_where_it_was_set_and_falls_with_the_kernel_s_
 /// scaled by the kernel's lattice sum (`Kernel::density_scale`): without it Wendland C2 at
 /// h/dx = 1.8 reads the lattice at rest as compressed by 0.21%, the density correction
 /// expands the water, and its mean height rises by 0.23% (0.57 mm) within 1 s and still moves
-/// at 1.1e-4 m/s after 10 s; with it, 1.3e-6 m/s and no rise to 1 µm.
+/// at 1.1e-4 m/s after 10 s; with it, 1.3e-6 m/s and no rise to 1 µm (at the tolerance 1e-6;
+/// at the default 1e-4 the rms pressure error is 6e-6 and 3e-6 of ρgH and the water moves at
+/// 4e-5 and 2e-5 m/s over the second second, C2 and C4, 2026-12-06).
 #[test]
 fn still_water_stays_still_with_the_wendland_kernels() {
     use isph::math::kernel::KernelKind;
@@ -419,22 +434,24 @@ fn still_water_stays_still_with_the_wendland_kernels() {
         let dir = TempDir::new(&format!("hydrostatic-{}", kind.name()));
         let summary = run_scene(&scene, dir.path(), 2.0);
         let m = measure(Case::Hydrostatic, &scene, dir.path()).unwrap_or_else(|e| panic!("{e}"));
+        eprintln!("{kind:?}: rms {:e} bottom {:e}", m.error, m.details[0].1);
         assert!(
-            m.error < 0.005,
+            m.error < 1e-4,
             "{kind:?}: rms pressure error {} of ρgH",
             m.error
         );
         let bottom = m.details[0].1;
         assert!(
-            bottom.abs() < 0.005,
+            bottom.abs() < 1e-4,
             "{kind:?}: bottom pressure error {bottom}"
         );
         let speeds = stats_column(dir.path(), "max_speed");
         let late = speeds[speeds.len() / 2..]
             .iter()
             .fold(0.0, |a: f64, &b| a.max(b));
+        eprintln!("{kind:?}: late {late:e}");
         assert!(
-            late < 1e-3,
+            late < 2e-4,
             "{kind:?}: max speed {late} m/s over the second second"
         );
         let mean_height = |frame: usize| {

@@ -116,8 +116,8 @@ fn taylor_green_energy_follows_the_exact_decay() {
 }
 
 /// The same vortex at U = 0.2 m/s (Re = 50) to t = L/U, where the viscous term weighs twice as
-/// much against the step: the kinetic energy never more than 0.5% above the exact one and
-/// within 1% of it, the velocity L2 error below 1% at the end (docs/accuracy.md, "The viscous
+/// much against the step: the kinetic energy within 0.5% of the exact one throughout, the
+/// velocity L2 error below 1% at the end (docs/accuracy.md, "The viscous
 /// operator"). With Euler's step of Eq. (26) alone the energy ended 1.45% above the exact one
 /// (the kernel's smoothing of the Laplacian, σ²|k|²/4 of it, outweighed the step's error) and
 /// the L2 error was 0.77%. Measured now: the energy between −0.03% and +0.13% of the exact one,
@@ -126,8 +126,9 @@ fn taylor_green_energy_follows_the_exact_decay() {
 fn taylor_green_at_re_50_keeps_its_energy_within_half_a_per_cent() {
     let frames = taylor_green_frames(0.2, 1.0);
     for &(t, excess, _) in &frames {
+        eprintln!("t {t:.3}: energy {excess:+e}");
         assert!(
-            excess < 0.005 && excess > -0.01,
+            excess.abs() < 0.005,
             "kinetic energy {excess:+.4} off the exact one at t = {t:.3} L/U"
         );
     }
@@ -267,8 +268,9 @@ fn poiseuille_follows_the_start_up_series_and_converges() {
         assert!(cross < 1e-3, "velocity across the channel {cross} of u_max");
     }
     let p = order(coarse.error, fine.error);
+    eprintln!("poiseuille order {p}");
     assert!(
-        p > 1.0,
+        p > 1.5,
         "profile error {} → {}: order {p}",
         coarse.error,
         fine.error
