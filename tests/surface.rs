@@ -212,15 +212,27 @@ fn a_ball_gives_a_closed_outward_sphere_of_its_volume_and_area_with_each_kernel(
             "{kernel:?}: normals {mean}° / {worst}° off the radius"
         );
         // The particles move as u = (y, −x, 0.5): the kernel-weighted mean gives the constant
-        // part exactly and the linear part within the one-sided reach of the kernel at the
-        // surface (its support, 2–4 spacings, times the gradient 1/s).
+        // part exactly, and the linear part at the weighted centroid of the particles in reach,
+        // which a vertex on the surface has on one side only: at most 3/8 of the support
+        // inwards (a half ball of uniform weight; measured 0.18–0.34 of it over the kernels),
+        // times the gradient 1/s.
         let support = kernel.default_radius() * dx + dx / 2.0;
+        let worst_u = mesh
+            .positions
+            .iter()
+            .zip(&mesh.velocity)
+            .map(|(p, u)| (u[0] - p[1]).abs().max((u[1] + p[0]).abs()))
+            .fold(0.0f32, f32::max);
+        println!(
+            "{kernel:?}: velocity off the exact one by {:.3} of the support at most",
+            worst_u / support as f32
+        );
         for (p, u) in mesh.positions.iter().zip(&mesh.velocity) {
             assert!((u[2] - 0.5).abs() < 1e-5, "{kernel:?}: w = {}", u[2]);
             let exact = [p[1], -p[0]];
             for d in 0..2 {
                 assert!(
-                    (u[d] - exact[d]).abs() < support as f32,
+                    (u[d] - exact[d]).abs() < 0.375 * support as f32,
                     "{kernel:?}: u = {u:?} at {p:?}"
                 );
             }
