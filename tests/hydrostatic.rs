@@ -250,8 +250,9 @@ fn a_deep_periodic_layering_stays_at_rest() {
 /// off from the free surface, and stands 0.2 m deep on the right. The sealed water has no
 /// pressure level of its own (its part of the PPE is singular: without a reference every solve
 /// runs to `max_iterations`; docs/stabilisation.md, "Water sealed off from the free surface");
-/// its highest particle is pinned like a free surface. Measured: 1.3 PPE iterations a step,
-/// the water still to 6e-5 m/s over 3 s, the sealed pressure hydrostatic from its top.
+/// its highest particle is pinned like a free surface. Measured over 1 s at the default
+/// tolerance: at most 19 PPE iterations a step, the water still to 1.8e-4 m/s (6e-5 m/s over
+/// 3 s at 1e-6), the sealed pressure hydrostatic from its top (2026-12-06).
 #[test]
 fn water_sealed_off_from_the_free_surface_stays_at_rest() {
     let scene = scene_from_text(
@@ -274,11 +275,8 @@ fn water_sealed_off_from_the_free_surface_stays_at_rest() {
     let speed = stats_column(out, "max_speed")
         .into_iter()
         .fold(0.0, f64::max);
-    let depth: f64 = 0.5;
-    assert!(
-        speed < 0.01 * (9.81 * depth).sqrt(),
-        "max speed {speed} m/s"
-    );
+    eprintln!("sealed: max speed {speed:e}");
+    assert!(speed < 1e-3, "max speed {speed} m/s");
     // The sealed water's pressure: ρ0 g below its highest particle.
     let last = summary.frames.len() - 1;
     let (kind, pos, pressure): (Vec<i32>, Vec<f64>, Vec<f64>) = (
@@ -293,7 +291,7 @@ fn water_sealed_off_from_the_free_surface_stays_at_rest() {
         .iter()
         .map(|&i| pos[3 * i + 1])
         .fold(f64::MIN, f64::max);
-    let rho_g_h = 1000.0 * 9.81 * depth;
+    let rho_g_h = 1000.0 * 9.81 * 0.5; // the sealed water's depth
     for &i in &sealed {
         let hydrostatic = 1000.0 * 9.81 * (top - pos[3 * i + 1]);
         assert!(
