@@ -277,6 +277,26 @@ fn an_existing_run_is_never_overwritten_by_accident() {
     );
     let (code, stderr) = run_text(dir.path(), &good(), &["--overwrite"]);
     assert_eq!(code, 0, "{stderr}");
+    // A folder holding only another run's bodies.csv is not written into either.
+    let other = TempDir::new("existing-bodies");
+    std::fs::create_dir(other.path().join("out")).unwrap();
+    let bodies = other.path().join("out/bodies.csv");
+    std::fs::write(&bodies, "time,body\n").unwrap();
+    let (code, stderr) = run_text(other.path(), &good(), &[]);
+    assert_refused(code, &stderr, &["bodies.csv", "--overwrite"]);
+    assert_eq!(std::fs::read_to_string(&bodies).unwrap(), "time,body\n");
+}
+
+/// A TOML syntax error is one line: where it is and what is wrong, not the source line echoed
+/// with a caret under it.
+#[test]
+fn a_toml_syntax_error_is_one_line() {
+    let dir = TempDir::new("toml-one-line");
+    let long = format!("{}\ncolour = \"{}", good(), "x".repeat(10_000));
+    let (code, stderr) = run_text(dir.path(), &long, &[]);
+    assert_refused(code, &stderr, &["TOML parse error at line 22"]);
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(stderr.len() < 500, "{} bytes of error", stderr.len());
 }
 
 /// `isph plan x | head -1`, `isph run x | true`: a reader of stdout that has gone away is not
