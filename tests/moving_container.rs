@@ -67,7 +67,7 @@ fn a_tank_tilted_slowly_keeps_its_water_level_in_the_laboratory() {
 }
 
 #[test]
-fn the_spheric_10_tank_hits_its_wall_when_the_experiment_does() {
+fn the_spheric_10_tank_hits_its_wall_near_the_experiments_onsets() {
     // The experiment's impact onsets (pressure above 1 kPa on the left-wall sensor) are 2.375
     // and 4.050 s, the benchmark's tolerance 0.03 s. The scene rolls the tank by the
     // experiment's roll (tools/spheric10_roll.py). Measured (the first sample above 1 kPa):
