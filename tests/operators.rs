@@ -22,17 +22,19 @@ fn laplacian_of_quadratic<const D: usize>(n: i64, h_over_dx: f64) -> f64 {
     lap
 }
 
+/// The lattice's sums of Eq. (27) give the constant to within 1e-3 at h/dx 1.0, 1.2 and 1.5 in
+/// 2D and 3D (measured 7e-5 to 9.9e-4, 2026-12-06): the kernel's discrete second moment.
 #[test]
-fn laplacian_of_a_quadratic_is_the_exact_constant() {
+fn laplacian_of_a_quadratic_is_its_constant_to_two_tenths_of_a_per_cent() {
     for h_over_dx in [1.0, 1.2, 1.5] {
         let l2 = laplacian_of_quadratic::<2>(15, h_over_dx);
         let l3 = laplacian_of_quadratic::<3>(13, h_over_dx);
         assert!(
-            (l2 / 4.0 - 1.0).abs() < 0.02,
+            (l2 / 4.0 - 1.0).abs() < 2e-3,
             "2D h/dx {h_over_dx}: {l2} vs 4"
         );
         assert!(
-            (l3 / 6.0 - 1.0).abs() < 0.02,
+            (l3 / 6.0 - 1.0).abs() < 2e-3,
             "3D h/dx {h_over_dx}: {l3} vs 6"
         );
     }
