@@ -21,6 +21,14 @@ impl Aabb {
             .all(|((x, lo), hi)| *x > lo - margin && *x < hi + margin)
     }
 
+    /// Lattice points of `spacing` the box holds, at most, with `layers(d)` more on each side
+    /// along axis d: counted, not made.
+    pub fn lattice_points_bound(&self, spacing: f64, layers: impl Fn(usize) -> f64) -> f64 {
+        (0..self.min.len())
+            .map(|d| ((self.max[d] - self.min[d]) / spacing).ceil() + 1.0 + 2.0 * layers(d))
+            .product()
+    }
+
     /// True when the box lies inside `outer` (faces may touch).
     pub fn within(&self, outer: &Aabb) -> bool {
         (0..self.min.len()).all(|d| self.min[d] >= outer.min[d] && self.max[d] <= outer.max[d])

@@ -97,12 +97,6 @@ impl SolverSettings {
     pub fn support_in_dx(&self) -> f64 {
         self.kernel.support_in_h() * self.h_over_dx
     }
-
-    /// The kernel's support radius [m] at particle spacing `spacing`, with the bits
-    /// `Kernel::support` gives it.
-    pub fn support(&self, spacing: f64) -> f64 {
-        self.kernel.support_in_h() * (self.h_over_dx * spacing)
-    }
 }
 
 impl Default for SolverSettings {
@@ -305,35 +299,25 @@ impl Scene {
     /// and the extent of the cell list and the multigrid's first level.
     pub fn container_points(&self) -> f64 {
         let layers = self.wall_layers() as f64;
-        let c = &self.container;
-        (0..self.dimensions)
-            .map(|d| {
-                let walls = if self.periodic[d] { 0.0 } else { 2.0 * layers };
-                ((c.max[d] - c.min[d]) / self.spacing).ceil() + 1.0 + walls
-            })
-            .product()
+        self.container.lattice_points_bound(self.spacing, |d| {
+            if self.periodic[d] {
+                0.0
+            } else {
+                layers
+            }
+        })
     }
 
     /// At least as many particles as `fill::build` makes, fluid and wall, counted without making
     /// them (blocks and obstacles as if none overlapped another): a scene too large for the machine
     /// is refused before its particles fill the memory.
     pub fn particle_bound(&self) -> f64 {
-        let scene = self;
-        // Lattice points along axis d of box b, at most; with `grow` more on each side.
-        let along = |b: &Aabb, d: usize, grow: f64| {
-            ((b.max[d] - b.min[d]) / scene.spacing).ceil() + 1.0 + 2.0 * grow
-        };
-        let points =
-            |b: &Aabb| -> f64 { (0..scene.dimensions).map(|d| along(b, d, 0.0)).product() };
-        let layers = scene.wall_layers() as f64;
-        let c = &scene.container;
-        let inside = points(c);
-        let with_walls: f64 = (0..scene.dimensions)
-            .map(|d| along(c, d, if scene.periodic[d] { 0.0 } else { layers }))
-            .product();
-        let fluid: f64 = scene.blocks.iter().map(|b| points(&b.region)).sum();
-        let obstacles: f64 = scene.obstacles.iter().map(points).sum();
-        let bodies: f64 = scene.bodies.iter().map(|b| points(&b.shape.bounds())).sum();
+        let points = |b: &Aabb| b.lattice_points_bound(self.spacing, |_| 0.0);
+        let inside = points(&self.container);
+        let with_walls = self.container_points();
+        let fluid: f64 = self.blocks.iter().map(|b| points(&b.region)).sum();
+        let obstacles: f64 = self.obstacles.iter().map(points).sum();
+        let bodies: f64 = self.bodies.iter().map(|b| points(&b.shape.bounds())).sum();
         fluid.min(inside) + (with_walls - inside) + obstacles.min(inside) + bodies.min(inside)
     }
 

@@ -504,7 +504,7 @@ impl Validator<'_> {
                 flags.len()
             ),
         )?;
-        let support = solver.support(spacing);
+        let support = solver.support_in_dx() * spacing;
         for d in (0..dims).filter(|&d| flags[d]) {
             let length = container.max[d] - container.min[d];
             let spacings = length / spacing;
@@ -778,9 +778,7 @@ impl Validator<'_> {
                     container.max
                 ),
             )?;
-            let points: f64 = (0..dims)
-                .map(|d| ((bounds.max[d] - bounds.min[d]) / s.spacing).ceil() + 1.0)
-                .product();
+            let points = bounds.lattice_points_bound(s.spacing, |_| 0.0);
             self.memory_holds(
                 &format!("{key}.shape"),
                 &format!(
