@@ -135,3 +135,18 @@ fn a_periodic_flow_is_bit_identical_on_one_and_two_threads() {
     scene.output_interval = 0.05;
     assert_thread_count_independent("taylor-green", &scene, 0.15, 3);
 }
+
+/// In 3D, with a body falling into the water and a pressure probe under it: the 3D pair loops,
+/// the body's sums in three dimensions and the probe's are thread-count independent too.
+#[test]
+fn a_body_falling_into_3d_water_is_bit_identical_on_one_and_two_threads() {
+    let mut scene = shipped_scene("falling_body_3d.toml");
+    scene.spacing = 0.03;
+    scene.output_interval = 0.05;
+    scene.probes = vec![Probe {
+        name: "floor".into(),
+        point: vec![0.3, 0.3, 0.0],
+        field: ProbeField::Pressure,
+    }];
+    assert_thread_count_independent("falling-body-3d", &scene, 0.2, 4);
+}
