@@ -133,13 +133,72 @@ fn check<const D: usize>(n: i64) {
         .zip(&ax2)
         .all(|(a, b)| a.to_bits() == b.to_bits()));
     // The multigrid takes the fine diagonal from the coarse-row pass: it must have the bits of
-    // the operator's own diagonal (the weights summed in the same order).
+    // the operator's own diagonal (the weights summed in the same order). Each coarse row is
+    // row i of A times the first level's basis, so for a coarse vector c the rows give A P c,
+    // P c the fine vector c_0 + Σ_d c_d φ_d(x_j) of each unknown's cell (zero on the rows held
+    // fixed, here every seventh).
     let mut diagonal = vec![0.0; nf];
     op.diagonal(&mut diagonal);
-    let mut stencil = vec![0.0; 3usize.pow(D as u32)];
-    for i in 0..nf {
+    let held: Vec<Role> = (0..nf)
+        .map(|i| {
+            if i % 7 == 3 {
+                Role::Surface
+            } else {
+                Role::Interior
+            }
+        })
+        .collect();
+    let op = PressureOperator { roles: &held, ..op };
+    let (dims, m) = (op.dims(), 1 + D);
+    let coarse: Vec<f64> = (0..dims.iter().product::<usize>() * m)
+        .map(|k| (k * 7919 % 13) as f64 / 13.0 - 0.5)
+        .collect();
+    let fine: Vec<f64> = (0..nf)
+        .map(|j| {
+            op.aggregate(j).map_or(0.0, |c| {
+                let phi = op.linear_basis(j);
+                coarse[c * m] + (0..D).map(|d| phi[d] * coarse[c * m + 1 + d]).sum::<f64>()
+            })
+        })
+        .collect();
+    let mut a_fine = vec![0.0; nf];
+    op.apply(&fine, &mut a_fine);
+    let width = 3usize.pow(D as u32);
+    let mut stencil = vec![0.0; width * m];
+    for i in (0..nf).filter(|&i| held[i] == Role::Interior) {
+        stencil.fill(0.0);
         let a_ii = op.add_coarse_row(i, &mut stencil);
         assert_eq!(a_ii.to_bits(), diagonal[i].to_bits(), "a_ii of row {i}");
+        let cell = op.aggregate(i).expect("an interior row is aggregated");
+        let (mut sum, mut size) = (0.0, 0.0);
+        for slot in 0..width {
+            // The cell at the slot's offset (x fastest), inside the grid: the block is not
+            // periodic.
+            let (mut n, mut stride, mut rest, mut c) = (0, 1, slot, cell);
+            for d in 0..D {
+                let k = (c % dims[d]) as i64 + (rest % 3) as i64 - 1;
+                (c, rest) = (c / dims[d], rest / 3);
+                if k < 0 || k >= dims[d] as i64 {
+                    assert!(stencil[slot * m..(slot + 1) * m].iter().all(|&a| a == 0.0));
+                    n = usize::MAX;
+                    break;
+                }
+                n += k as usize * stride;
+                stride *= dims[d];
+            }
+            if n == usize::MAX {
+                continue;
+            }
+            for l in 0..m {
+                sum += stencil[slot * m + l] * coarse[n * m + l];
+                size += (stencil[slot * m + l] * coarse[n * m + l]).abs();
+            }
+        }
+        assert!(
+            close(sum, a_fine[i], size),
+            "coarse row {i}: {sum} against (A P c)_i {}",
+            a_fine[i]
+        );
     }
 
     for i in 0..nf {
