@@ -324,27 +324,18 @@ impl Aggregated<2> for Spray {
         Some(i / 2)
     }
 
-    /// The two unknowns of a cell sit at a quarter and three quarters of its width along x.
-    fn linear_basis(&self, i: usize) -> [f64; 2] {
-        [(i % 2) as f64 / 2.0 - 0.25, 0.0]
-    }
-
     fn add_coarse_row(&self, i: usize, row: &mut [f64]) -> f64 {
         if Self::isolated(i) {
             return 1.0;
         }
         let (w, end) = Self::weights(i);
-        let a_ii = end + w.iter().map(|&(_, w)| w).sum::<f64>();
-        let mut add = |j: usize, a: f64| {
-            let slot = stencil_slot([(j / 2) as i64 - (i / 2) as i64, 0]);
-            row[3 * slot] += a;
-            row[3 * slot + 1] += a * self.linear_basis(j)[0];
-        };
-        add(i, a_ii);
+        let centre = stencil_slot([0, 0]);
+        row[centre] += end;
         for &(j, w) in &w {
-            add(j, -w);
+            row[centre] += w;
+            row[stencil_slot([(j / 2) as i64 - (i / 2) as i64, 0])] -= w;
         }
-        a_ii
+        end + w.iter().map(|&(_, w)| w).sum::<f64>()
     }
 }
 

@@ -134,9 +134,9 @@ fn check<const D: usize>(n: i64) {
         .all(|(a, b)| a.to_bits() == b.to_bits()));
     // The multigrid takes the fine diagonal from the coarse-row pass: it must have the bits of
     // the operator's own diagonal (the weights summed in the same order). Each coarse row is
-    // row i of A times the first level's basis, so for a coarse vector c the rows give A P c,
-    // P c the fine vector c_0 + Σ_d c_d φ_d(x_j) of each unknown's cell (zero on the rows held
-    // fixed, here every seventh).
+    // row i of A summed over each neighbouring block, so for a coarse vector c the rows give
+    // A P c, P c the value c of each unknown's block (zero on the rows held fixed, here every
+    // seventh).
     let mut diagonal = vec![0.0; nf];
     op.diagonal(&mut diagonal);
     let held: Vec<Role> = (0..nf)
@@ -149,50 +149,38 @@ fn check<const D: usize>(n: i64) {
         })
         .collect();
     let op = PressureOperator { roles: &held, ..op };
-    let (dims, m) = (op.dims(), 1 + D);
-    let coarse: Vec<f64> = (0..dims.iter().product::<usize>() * m)
+    let dims = op.dims();
+    let coarse: Vec<f64> = (0..dims.iter().product::<usize>())
         .map(|k| (k * 7919 % 13) as f64 / 13.0 - 0.5)
         .collect();
     let fine: Vec<f64> = (0..nf)
-        .map(|j| {
-            op.aggregate(j).map_or(0.0, |c| {
-                let phi = op.linear_basis(j);
-                coarse[c * m] + (0..D).map(|d| phi[d] * coarse[c * m + 1 + d]).sum::<f64>()
-            })
-        })
+        .map(|j| op.aggregate(j).map_or(0.0, |c| coarse[c]))
         .collect();
     let mut a_fine = vec![0.0; nf];
     op.apply(&fine, &mut a_fine);
-    let width = 3usize.pow(D as u32);
-    let mut stencil = vec![0.0; width * m];
+    let mut stencil = vec![0.0; 3usize.pow(D as u32)];
     for i in (0..nf).filter(|&i| held[i] == Role::Interior) {
         stencil.fill(0.0);
         let a_ii = op.add_coarse_row(i, &mut stencil);
         assert_eq!(a_ii.to_bits(), diagonal[i].to_bits(), "a_ii of row {i}");
         let cell = op.aggregate(i).expect("an interior row is aggregated");
         let (mut sum, mut size) = (0.0, 0.0);
-        for slot in 0..width {
-            // The cell at the slot's offset (x fastest), inside the grid: the block is not
-            // periodic.
+        for (slot, &a) in stencil.iter().enumerate() {
+            // The block at the slot's offset (x fastest), inside the grid: the particles are
+            // not periodic.
             let (mut n, mut stride, mut rest, mut c) = (0, 1, slot, cell);
             for d in 0..D {
                 let k = (c % dims[d]) as i64 + (rest % 3) as i64 - 1;
                 (c, rest) = (c / dims[d], rest / 3);
-                if k < 0 || k >= dims[d] as i64 {
-                    assert!(stencil[slot * m..(slot + 1) * m].iter().all(|&a| a == 0.0));
-                    n = usize::MAX;
-                    break;
-                }
-                n += k as usize * stride;
+                assert!(
+                    k >= 0 && k < dims[d] as i64 || a == 0.0,
+                    "row {i} slot {slot}"
+                );
+                n += k.clamp(0, dims[d] as i64 - 1) as usize * stride;
                 stride *= dims[d];
             }
-            if n == usize::MAX {
-                continue;
-            }
-            for l in 0..m {
-                sum += stencil[slot * m + l] * coarse[n * m + l];
-                size += (stencil[slot * m + l] * coarse[n * m + l]).abs();
-            }
+            sum += a * coarse[n];
+            size += (a * coarse[n]).abs();
         }
         assert!(
             close(sum, a_fine[i], size),

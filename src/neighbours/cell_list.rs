@@ -187,16 +187,6 @@ impl<const D: usize> CellList<D> {
         (cell * F64s::splat(1.0 / subdivision(d) as f64)).floor()
     }
 
-    /// The offset of x from the centre of its block `block` along axis d, in block widths
-    /// (in [−½, ½]; in lanes, `block` from `block_along_lanes`).
-    #[inline(always)]
-    pub fn offset_in_block_along_lanes(&self, d: usize, x: F64s, block: F64s) -> F64s {
-        let width = self.width[d] * subdivision(d) as f64;
-        let centre =
-            (block + F64s::splat(0.5)).mul_add(F64s::splat(width), F64s::splat(self.origin[d]));
-        (x - centre) * F64s::splat(1.0 / width)
-    }
-
     /// The per-particle array of the grid: the cell of each particle in the sorted order.
     pub fn sorted_cells(&self) -> ArraySize {
         ArraySize::of("cell of sorted particle", &self.sorted_cell)

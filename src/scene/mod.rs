@@ -102,7 +102,7 @@ impl SolverSettings {
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {
-            tolerance: 1.0e-5,
+            tolerance: 1.0e-4,
             max_iterations: 1000,
             alpha: 0.3,
             cfl: 0.4,

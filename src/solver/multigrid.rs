@@ -1,17 +1,11 @@
 //! Aggregation multigrid preconditioner for the PPE: the fine Jacobi step plus a coarse-grid
 //! correction computed by a V-cycle over the blocks of the cell list.
 //!
-//! Level 0 is the particle operator itself, applied matrix-free. Level 1 has 1 + D unknowns per
+//! Level 0 is the particle operator itself, applied matrix-free. Level 1 has one unknown per
 //! block of the cell list (`CellList::blocks`, each at least one kernel support wide): the
-//! particles of a block form one aggregate, and a block's unknowns are the coefficients of a
-//! constant and of the D linear functions φ_d = (x_d − c_d)/H_d about its centre c (H its
-//! width), so interpolation is linear within each block and discontinuous between blocks. The
-//! coarse operator is the Galerkin product A₁ = Pᵀ A P, a 3^D-point stencil of (1 + D) × (1 + D)
-//! blocks since a block is one support wide, smoothed by block Jacobi. A linear function per
-//! block represents a smooth pressure error to second order where a constant leaves its slope:
-//! BiCGSTAB takes about two thirds of the iterations of constant aggregates
-//! (docs/performance.md, "The pressure solve"). Each further level merges 2^D cells of the
-//! level below's constant parts, piecewise constant, which keeps the 3^D stencil. The coarsest
+//! particles of a block form one aggregate, interpolation is piecewise constant, and the coarse
+//! operator is the Galerkin product A₁ = Pᵀ A P, a 3^D-point stencil since a block is one
+//! support wide. Each further level merges 2^D cells, which keeps the 3^D stencil. The coarsest
 //! level (at most `COARSEST` cells) is relaxed by many sweeps; the others are smoothed by damped
 //! Jacobi, `SMOOTHING_SWEEPS` sweeps before and after their coarse correction, which
 //! piecewise-constant interpolation leaves too small on smooth errors and is scaled by
@@ -59,13 +53,8 @@ const NEGLIGIBLE_DIAGONAL: f64 = 1e-12;
 /// A row of level 1 whose sum exceeds this fraction of its Σ|a| couples to a fixed unknown
 /// (the sum of a row coupled to none is zero but for rounding, ~1e-16 of Σ|a|).
 const ANCHORED_ROW_SUM: f64 = 1e-9;
-/// A pivot at most this fraction of its diagonal block's Σ|a| makes the block singular
-/// (`invert_block`): the linear functions of a cell with particles on one line or plane are
-/// not independent, and their block's rounding would put a large factor into the smoother.
-const SINGULAR_PIVOT: f64 = 1e-4;
-/// A level with fewer active cells than this (over m² for m unknowns per cell) computes its
-/// residual on the calling thread: a row is a few dozen flops per unknown pair, less than
-/// handing the work to the pool costs.
+/// A level with fewer active cells than this computes its residual on the calling thread: a
+/// row is a few dozen flops, less than handing the work to the pool costs.
 const PARALLEL_CELLS: usize = 8192;
 
 /// A particle operator whose unknowns are grouped into the cells of a grid of `dims` cells
@@ -75,15 +64,10 @@ pub trait Aggregated<const D: usize>: LinearOperator {
     /// The cell of unknown i, or None for an unknown held fixed (a Dirichlet row of the
     /// identity, outside every aggregate).
     fn aggregate(&self, i: usize) -> Option<usize>;
-    /// φ(x_i) ∈ [−½, ½]^D: unknown i's offset from the centre of its cell, in cell widths.
-    /// Level 1 has 1 + D unknowns per cell, the coefficients of the constant φ_0 = 1 and of
-    /// the linear functions φ_1 … φ_D.
-    fn linear_basis(&self, i: usize) -> [f64; D];
-    /// Adds row i of A times the basis of level 1 into the stencil row of i's cell:
-    /// `row[slot (1 + D) + l] += a_ij φ_l(x_j)` for each entry and l = 0 … D, with `slot` the
-    /// position of j's cell in the 3^D stencil around i's cell (see [`stencil_slot`]). Returns
-    /// a_ii with the bits `LinearOperator::diagonal` gives it: the build takes the fine
-    /// diagonal from here instead of from a pass of its own.
+    /// Adds row i of A into the stencil row of its cell: `row[slot] += a_ij` for each entry,
+    /// with `slot` the position of j's cell in the 3^D stencil around i's cell (see
+    /// [`stencil_slot`]). Returns a_ii with the bits `LinearOperator::diagonal` gives it: the
+    /// build takes the fine diagonal from here instead of from a pass of its own.
     fn add_coarse_row(&self, i: usize, row: &mut [f64]) -> f64;
 }
 
@@ -105,14 +89,10 @@ fn cell_offset<const D: usize>(dims: [usize; D], from: usize, to: usize) -> [i64
     })
 }
 
-/// The 3^D-point stencils of one structured level over its active cells: one row of `3^D`
-/// blocks of m × m coefficients (row-major) per active cell (m unknowns per cell), the form
-/// the Galerkin products are summed in.
+/// The 3^D-point stencils of one structured level, one row of `3^D` coefficients per cell of
+/// its grid, x fastest: the form the Galerkin products are summed in.
 struct Stencils<const D: usize> {
     dims: [usize; D],
-    m: usize,
-    /// Grid index of each active cell, ascending (x fastest).
-    cells: Vec<u32>,
     rows: Vec<f64>,
 }
 
@@ -120,88 +100,34 @@ impl<const D: usize> Stencils<D> {
     const WIDTH: usize = 3usize.pow(D as u32);
     const CENTRE: usize = (Self::WIDTH - 1) / 2;
 
-    fn new(dims: [usize; D], m: usize, cells: Vec<u32>) -> Self {
+    fn new(dims: [usize; D]) -> Self {
+        let n: usize = dims.iter().product();
         Self {
             dims,
-            m,
-            rows: vec![0.0; cells.len() * Self::WIDTH * m * m],
-            cells,
+            rows: vec![0.0; n * Self::WIDTH],
         }
     }
 
-    /// Coefficients of one cell's row.
-    fn row_len(&self) -> usize {
-        Self::WIDTH * self.m * self.m
+    /// Cells of the grid.
+    fn cells(&self) -> usize {
+        self.rows.len() / Self::WIDTH
     }
 
-    /// Row of active cell k.
-    fn row(&self, k: usize) -> &[f64] {
-        &self.rows[k * self.row_len()..(k + 1) * self.row_len()]
+    fn row(&self, c: usize) -> &[f64] {
+        &self.rows[c * Self::WIDTH..(c + 1) * Self::WIDTH]
     }
 
-    /// The active index of grid cell c, if active.
-    fn active_index(&self, c: usize) -> Option<usize> {
-        self.cells.binary_search(&(c as u32)).ok()
-    }
-
-    /// The active index of the neighbour of active cell k in each slot of its stencil
-    /// (`u32::MAX`: outside the grid or holding no unknowns), in slot order.
-    fn neighbours(&self) -> Vec<u32> {
-        let mut neighbours = Vec::with_capacity(self.cells.len() * Self::WIDTH);
-        for &c in &self.cells {
-            for_each_offset::<D>(|_, offset| {
-                let n = neighbour(self.dims, c as usize, offset).and_then(|n| self.active_index(n));
-                neighbours.push(n.map_or(u32::MAX, |n| n as u32));
-            });
-        }
-        neighbours
-    }
-}
-
-/// The inverse of the m × m diagonal block `a` (row-major) of a row whose coefficients sum to
-/// `size` in absolute value, into `inv`: by Gauss–Jordan elimination with partial pivoting;
-/// where a pivot is negligible against the block (its unknowns' linear functions are not
-/// independent: a cell with one particle, or with particles in one plane), the inverse of its
-/// constant mode alone, 0 where that too is negligible against the row (`NEGLIGIBLE_DIAGONAL`).
-fn invert_block(a: &[f64], m: usize, size: f64, inv: &mut [f64]) {
-    inv.fill(0.0);
-    let constant_only = |inv: &mut [f64]| {
-        inv.fill(0.0);
-        if a[0] > NEGLIGIBLE_DIAGONAL * size {
-            inv[0] = 1.0 / a[0];
-        }
-    };
-    if m == 1 {
-        return constant_only(inv);
-    }
-    let block_size = a.iter().map(|a| a.abs()).sum::<f64>();
-    let mut w = a.to_vec();
-    for k in 0..m {
-        inv[k * m + k] = 1.0;
-    }
-    for col in 0..m {
-        let pivot = (col..m)
-            .max_by(|&x, &y| w[x * m + col].abs().total_cmp(&w[y * m + col].abs()))
-            .expect("a row");
-        if w[pivot * m + col].abs() <= SINGULAR_PIVOT * block_size {
-            return constant_only(inv);
-        }
-        for k in 0..m {
-            w.swap(col * m + k, pivot * m + k);
-            inv.swap(col * m + k, pivot * m + k);
-        }
-        let d = 1.0 / w[col * m + col];
-        for k in 0..m {
-            w[col * m + k] *= d;
-            inv[col * m + k] *= d;
-        }
-        for r in (0..m).filter(|&r| r != col) {
-            let f = w[r * m + col];
-            for k in 0..m {
-                w[r * m + k] -= f * w[col * m + k];
-                inv[r * m + k] -= f * inv[col * m + k];
+    /// Calls `f(n, a_cn)` for the nonzero coefficients of cell c's row, in stencil-slot order,
+    /// with n the neighbour cell's grid index.
+    fn for_each_coefficient(&self, c: usize, mut f: impl FnMut(usize, f64)) {
+        let row = self.row(c);
+        for_each_offset::<D>(|slot, offset| {
+            if row[slot] != 0.0 {
+                if let Some(n) = neighbour(self.dims, c, offset) {
+                    f(n, row[slot]);
+                }
             }
-        }
+        });
     }
 }
 
@@ -210,22 +136,19 @@ fn invert_block(a: &[f64], m: usize, size: f64, inv: &mut [f64]) {
 /// and a zero right-hand side, solution and residual, so they are left out.
 struct Level<const D: usize> {
     dims: [usize; D],
-    /// Unknowns per cell: 1, or 1 + D on a first level with linear functions.
-    m: usize,
     /// Grid index of each active cell, ascending.
     cells: Vec<u32>,
-    /// The operator as the 3^D stencil of m × m blocks (row-major) of each active cell, in
-    /// slot order: `value[(k 3^D + slot) m² ..]` couples active cell k to active cell
-    /// `neighbour[k 3^D + slot]` (`u32::MAX`, and a zero block, where there is none). Held as
-    /// the build sums it, so that the hierarchy is never held twice.
-    neighbour: Vec<u32>,
+    /// The operator in compressed rows over the active cells: row k's coefficients are
+    /// `value[start[k]..start[k + 1]]`, in stencil-slot order, coupling active cell k to
+    /// active cells `column[..]`.
+    start: Vec<u32>,
+    column: Vec<u32>,
     value: Vec<f64>,
-    /// The inverse of each cell's diagonal block (m × m).
     inv_diag: Vec<f64>,
     /// The active cell of the next coarser level holding each active cell (empty on the
     /// coarsest).
     parent: Vec<u32>,
-    /// Right-hand side, solution and residual of this level, m per cell.
+    /// Right-hand side, solution and residual of this level.
     b: Vec<f64>,
     x: Vec<f64>,
     r: Vec<f64>,
@@ -236,45 +159,42 @@ impl<const D: usize> Level<D> {
     /// cells holding unknowns. A cell whose unknowns couple to nothing (every weight of their
     /// rows clipped: spray torn off at a large time step) has a zero diagonal here, or one
     /// that is zero but for rounding (`NEGLIGIBLE_DIAGONAL`), and takes no smoothing correction.
-    fn of(stencils: Stencils<D>) -> Self {
-        let (m, mm) = (stencils.m, stencils.m * stencils.m);
+    fn of(stencils: &Stencils<D>, cells: Vec<u32>) -> Self {
         let centre = Stencils::<D>::CENTRE;
-        let cells = stencils.cells.len();
-        let mut inv_diag = vec![0.0; cells * mm];
-        for (k, inv) in inv_diag.chunks_exact_mut(mm).enumerate() {
-            let row = stencils.row(k);
-            let size = row.iter().map(|a| a.abs()).sum::<f64>();
-            invert_block(&row[centre * mm..(centre + 1) * mm], m, size, inv);
-        }
-        Self {
+        let mut level = Self {
             dims: stencils.dims,
-            m,
-            neighbour: stencils.neighbours(),
-            value: stencils.rows,
-            inv_diag,
+            start: vec![0],
+            column: Vec::new(),
+            value: Vec::new(),
+            inv_diag: cells
+                .iter()
+                .map(|&c| {
+                    let row = stencils.row(c as usize);
+                    let size = row.iter().map(|a| a.abs()).sum::<f64>();
+                    if row[centre] > NEGLIGIBLE_DIAGONAL * size {
+                        1.0 / row[centre]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
             parent: Vec::new(),
-            b: vec![0.0; cells * m],
-            x: vec![0.0; cells * m],
-            r: vec![0.0; cells * m],
-            cells: stencils.cells,
+            b: vec![0.0; cells.len()],
+            x: vec![0.0; cells.len()],
+            r: vec![0.0; cells.len()],
+            cells,
+        };
+        for k in 0..level.cells.len() {
+            stencils.for_each_coefficient(level.cells[k] as usize, |n, a| {
+                let n = level
+                    .active_index(n)
+                    .expect("a coupled cell holds unknowns");
+                level.column.push(n as u32);
+                level.value.push(a);
+            });
+            level.start.push(level.column.len() as u32);
         }
-    }
-
-    /// The (slot, neighbour's active index) of active cell k's stencil entries that couple to
-    /// a cell holding unknowns, in slot order; the entry's block is `block(k, slot)`.
-    fn entries(&self, k: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
-        let width = Stencils::<D>::WIDTH;
-        self.neighbour[k * width..(k + 1) * width]
-            .iter()
-            .enumerate()
-            .filter(|&(_, &n)| n != u32::MAX)
-            .map(|(slot, &n)| (slot, n as usize))
-    }
-
-    /// The m × m block of active cell k's stencil slot `slot`.
-    fn block(&self, k: usize, slot: usize) -> &[f64] {
-        let (mm, width) = (self.m * self.m, Stencils::<D>::WIDTH);
-        &self.value[(k * width + slot) * mm..(k * width + slot + 1) * mm]
+        level
     }
 
     fn len(&self) -> usize {
@@ -293,71 +213,56 @@ impl<const D: usize> Level<D> {
 
     /// r = b − A x on this level.
     fn residual(&mut self) {
-        match self.m {
-            1 => self.residual_of::<1>(),
-            3 => self.residual_of::<3>(),
-            4 => self.residual_of::<4>(),
-            m => unreachable!("{m} unknowns per cell: 1, or 1 + D"),
-        }
-    }
-
-    /// `residual` with M unknowns per cell, each block row an unrolled product.
-    fn residual_of<const M: usize>(&mut self) {
-        let mut r = std::mem::take(&mut self.r);
-        let (x, b) = (&self.x, &self.b);
-        let row = |k: usize| -> [f64; M] {
-            let mut r: [f64; M] = std::array::from_fn(|l| b[k * M + l]);
-            for (slot, n) in self.entries(k) {
-                let (a, x) = (self.block(k, slot), &x[n * M..(n + 1) * M]);
-                for l in 0..M {
-                    for c in 0..M {
-                        r[l] -= a[l * M + c] * x[c];
-                    }
-                }
-            }
-            r
+        let (start, column, value, x, b) =
+            (&self.start, &self.column, &self.value, &self.x, &self.b);
+        let row = |k: usize| {
+            let entries = start[k] as usize..start[k + 1] as usize;
+            column[entries.clone()]
+                .iter()
+                .zip(&value[entries])
+                .fold(b[k], |s, (&n, &a)| s - a * x[n as usize])
         };
-        if self.len() * M * M < PARALLEL_CELLS {
-            for (k, r) in r.chunks_exact_mut(M).enumerate() {
-                r.copy_from_slice(&row(k));
+        if self.r.len() < PARALLEL_CELLS {
+            for (k, r) in self.r.iter_mut().enumerate() {
+                *r = row(k);
             }
         } else {
-            r.par_chunks_exact_mut(M)
-                .enumerate()
-                .for_each(|(k, r)| r.copy_from_slice(&row(k)));
+            fill(&mut self.r, row);
         }
-        self.r = r;
     }
 
     /// The next coarser level: 2^D cells merged, A_c = Pᵀ A P. Sets this level's `parent`.
-    /// Of a level with linear functions, the constant functions' part only (their coarse
-    /// interpolation is the constant).
     fn coarsen(&mut self) -> Level<D> {
-        let dims = self.dims.map(|n| n.div_ceil(2));
-        let parent_of = |c: u32| parent_cell(self.dims, dims, c as usize) as u32;
-        let mut parents: Vec<u32> = self.cells.iter().map(|&c| parent_of(c)).collect();
+        let mut stencils = Stencils::new(self.dims.map(|n| n.div_ceil(2)));
+        let w = Stencils::<D>::WIDTH;
+        for k in 0..self.len() {
+            let parent = parent_cell(self.dims, stencils.dims, self.cells[k] as usize);
+            for e in self.start[k] as usize..self.start[k + 1] as usize {
+                let n = self.cells[self.column[e] as usize] as usize;
+                let to = parent_cell(self.dims, stencils.dims, n);
+                let s = stencil_slot(cell_offset(stencils.dims, parent, to));
+                stencils.rows[parent * w + s] += self.value[e];
+            }
+        }
+        let mut parents: Vec<u32> = self
+            .cells
+            .iter()
+            .map(|&c| parent_cell(self.dims, stencils.dims, c as usize) as u32)
+            .collect();
         parents.sort_unstable();
         parents.dedup();
-        let mut stencils = Stencils::new(dims, 1, parents);
+        let coarse = Level::of(&stencils, parents);
         self.parent = self
             .cells
             .iter()
             .map(|&c| {
-                stencils
-                    .active_index(parent_of(c) as usize)
+                let p = parent_cell(self.dims, coarse.dims, c as usize);
+                coarse
+                    .active_index(p)
                     .expect("an active cell's parent is active") as u32
             })
             .collect();
-        let w = Stencils::<D>::WIDTH;
-        for k in 0..self.len() {
-            let parent = stencils.cells[self.parent[k] as usize] as usize;
-            for (slot, n) in self.entries(k) {
-                let to = parent_of(self.cells[n]) as usize;
-                let s = stencil_slot(cell_offset(dims, parent, to));
-                stencils.rows[self.parent[k] as usize * w + s] += self.block(k, slot)[0];
-            }
-        }
-        Level::of(stencils)
+        coarse
     }
 }
 
@@ -415,8 +320,6 @@ pub struct Multigrid<const D: usize> {
     fine_inv_diag: Vec<f64>,
     /// Cell of each fine unknown (`u32::MAX`: outside every aggregate).
     fine_cell: Vec<u32>,
-    /// φ(x_i) of each fine unknown where the first level has linear functions (else empty).
-    fine_basis: Vec<[f64; D]>,
     levels: Vec<Level<D>>,
 }
 
@@ -456,9 +359,11 @@ impl Members {
             .collect()
     }
 
-    /// The unknowns of cell c.
-    fn of_cell(&self, c: usize) -> &[u32] {
-        &self.unknowns[self.start[c] as usize..self.start[c + 1] as usize]
+    /// The unknowns of each cell in turn.
+    fn cells(&self) -> impl Iterator<Item = &[u32]> {
+        self.start
+            .windows(2)
+            .map(|w| &self.unknowns[w[0] as usize..w[1] as usize])
     }
 }
 
@@ -472,23 +377,21 @@ impl<const D: usize> Multigrid<D> {
         let Some(first) = self.levels.first() else {
             return Vec::new();
         };
+        let entries = |k: usize| first.start[k] as usize..first.start[k + 1] as usize;
         // Union–find over the active cells, each set named by its smallest cell.
         let mut root: Vec<usize> = (0..first.len()).collect();
         for k in 0..first.len() {
-            for (slot, n) in first.entries(k) {
-                if first.block(k, slot).iter().all(|&a| a == 0.0) {
-                    continue;
-                }
-                let (a, b) = (find(&mut root, k), find(&mut root, n));
+            for e in entries(k) {
+                let (a, b) = (
+                    find(&mut root, k),
+                    find(&mut root, first.column[e] as usize),
+                );
                 root[a.max(b)] = a.min(b);
             }
         }
         let mut anchored = vec![false; first.len()];
         for k in 0..first.len() {
-            let row: Vec<f64> = first
-                .entries(k)
-                .map(|(slot, _)| first.block(k, slot)[0])
-                .collect();
+            let row = &first.value[entries(k)];
             let size: f64 = row.iter().map(|a| a.abs()).sum();
             if row.iter().sum::<f64>() > ANCHORED_ROW_SUM * size {
                 anchored[find(&mut root, k)] = true;
@@ -518,64 +421,41 @@ impl<const D: usize> Multigrid<D> {
         let Multigrid {
             fine_inv_diag,
             fine_cell,
-            fine_basis,
             levels: _,
         } = self;
         vec![
             ArraySize::of("multigrid D⁻¹", fine_inv_diag),
             ArraySize::of("multigrid aggregate", fine_cell),
-            ArraySize::of("multigrid linear basis", fine_basis),
         ]
     }
 
     /// Builds the hierarchy for operator `a`.
     pub fn build(&mut self, a: &impl Aggregated<D>) -> Result<(), SolverError> {
-        // The last hierarchy goes before the new one is summed: the two are not held at once.
-        self.levels.clear();
         let n = a.len();
         self.fine_cell.resize(n, 0);
         fill(&mut self.fine_cell, |i| {
             a.aggregate(i).map_or(u32::MAX, |c| c as u32)
         });
 
-        let m = 1 + D;
-        self.fine_basis.resize(n, [0.0; D]);
-        fill(&mut self.fine_basis, |i| a.linear_basis(i));
-        let dims = a.dims();
-        let members = Members::of(&self.fine_cell, dims.iter().product());
-        let mut first = Stencils::new(dims, m, members.occupied());
+        let mut first = Stencils::new(a.dims());
+        let members = Members::of(&self.fine_cell, first.cells());
         // Each cell's stencil row is the sum of its unknowns' rows, in index order; each row
         // gives its own a_ii on the way.
         let mut diagonal = vec![0.0; members.unknowns.len()];
-        let mut tasks = Vec::with_capacity(first.cells.len());
+        let mut tasks = Vec::with_capacity(members.start.len());
         let mut diagonals = &mut diagonal[..];
-        let row_len = first.row_len();
-        for (row, &c) in first.rows.chunks_mut(row_len).zip(&first.cells) {
-            let unknowns = members.of_cell(c as usize);
+        for (row, unknowns) in first
+            .rows
+            .chunks_mut(Stencils::<D>::WIDTH)
+            .zip(members.cells())
+        {
             let (these, rest) = std::mem::take(&mut diagonals).split_at_mut(unknowns.len());
             tasks.push((row, unknowns, these));
             diagonals = rest;
         }
-        let basis = &self.fine_basis;
         tasks.into_par_iter().for_each(|(row, unknowns, diagonal)| {
-            // Block (k, l) of slot L of row K of P₁ᵀ A P₁: Σ_i∈K φ_k(x_i) Σ_j∈L a_ij φ_l(x_j).
-            let mut times_basis = vec![0.0; Stencils::<D>::WIDTH * m];
             for (&i, d) in unknowns.iter().zip(diagonal) {
-                times_basis.fill(0.0);
-                *d = a.add_coarse_row(i as usize, &mut times_basis);
-                let phi = basis[i as usize];
-                for (slot, from) in times_basis.chunks_exact(m).enumerate() {
-                    if from.iter().all(|&f| f == 0.0) {
-                        continue;
-                    }
-                    for k in 0..m {
-                        let phi_k = if k == 0 { 1.0 } else { phi[k - 1] };
-                        let to = &mut row[(slot * m + k) * m..(slot * m + k + 1) * m];
-                        for (t, f) in to.iter_mut().zip(from) {
-                            *t += phi_k * f;
-                        }
-                    }
-                }
+                *d = a.add_coarse_row(i as usize, row);
             }
         });
         // The unknowns outside every aggregate are rows of the identity.
@@ -587,13 +467,14 @@ impl<const D: usize> Multigrid<D> {
             }
             self.fine_inv_diag[i as usize] = 1.0 / d;
         }
-        let first = Level::of(first);
+        let first = Level::of(&first, members.occupied());
         // From here on an aggregated unknown names its cell by its active index in level 1.
         for c in self.fine_cell.iter_mut().filter(|c| **c != u32::MAX) {
             *c = first
                 .active_index(*c as usize)
                 .expect("a cell with unknowns is active") as u32;
         }
+        self.levels.clear();
         self.levels.push(first);
         while self.levels.last().expect("a level").grid_cells() > COARSEST {
             let next = self.levels.last_mut().expect("a level").coarsen();
@@ -606,15 +487,10 @@ impl<const D: usize> Multigrid<D> {
     /// aggregate).
     fn restrict_fine(&mut self, r: &[f64]) {
         let first = &mut self.levels[0];
-        let m = first.m;
         first.b.fill(0.0);
-        for (i, (&r, &c)) in r.iter().zip(&self.fine_cell).enumerate() {
+        for (&r, &c) in r.iter().zip(&self.fine_cell) {
             if c != u32::MAX {
-                let c = c as usize * m;
-                first.b[c] += r;
-                for k in 1..m {
-                    first.b[c + k] += self.fine_basis[i][k - 1] * r;
-                }
+                first.b[c as usize] += r;
             }
         }
     }
@@ -639,15 +515,14 @@ impl<const D: usize> Multigrid<D> {
         level.residual();
         let coarse = &mut tail[0];
         coarse.b.fill(0.0);
-        let m = level.m;
-        for (&p, r) in level.parent.iter().zip(level.r.chunks_exact(m)) {
-            coarse.b[p as usize] += r[0];
+        for (&p, &r) in level.parent.iter().zip(&level.r) {
+            coarse.b[p as usize] += r;
         }
         self.cycle(k + 1);
         let (head, tail) = self.levels.split_at_mut(k + 1);
         let (level, coarse) = (&mut head[k], &tail[0]);
-        for (x, &p) in level.x.chunks_exact_mut(m).zip(&level.parent) {
-            x[0] += OVER_CORRECTION * coarse.x[p as usize];
+        for (x, &p) in level.x.iter_mut().zip(&level.parent) {
+            *x += OVER_CORRECTION * coarse.x[p as usize];
         }
         for _ in 0..SMOOTHING_SWEEPS {
             smooth(level);
@@ -658,19 +533,9 @@ impl<const D: usize> Multigrid<D> {
 /// One damped Jacobi sweep x ← x + ω D⁻¹ (b − A x) on a structured level.
 fn smooth<const D: usize>(level: &mut Level<D>) {
     level.residual();
-    let (x, r, d, m) = (&mut level.x, &level.r, &level.inv_diag, level.m);
-    if m == 1 {
-        for c in 0..x.len() {
-            x[c] += JACOBI_WEIGHT * d[c] * r[c];
-        }
-        return;
-    }
-    for (c, (x, r)) in x.chunks_exact_mut(m).zip(r.chunks_exact(m)).enumerate() {
-        let d = &d[c * m * m..(c + 1) * m * m];
-        for k in 0..m {
-            let dr: f64 = (0..m).map(|l| d[k * m + l] * r[l]).sum();
-            x[k] += JACOBI_WEIGHT * dr;
-        }
+    let (x, r, d) = (&mut level.x, &level.r, &level.inv_diag);
+    for c in 0..x.len() {
+        x[c] += JACOBI_WEIGHT * d[c] * r[c];
     }
 }
 
@@ -684,16 +549,10 @@ impl<const D: usize, A: Aggregated<D>> Preconditioner<A> for Multigrid<D> {
         self.restrict_fine(r);
         self.cycle(0);
         let (cells, first, inv) = (&self.fine_cell, &self.levels[0], &self.fine_inv_diag);
-        let (m, basis) = (first.m, &self.fine_basis);
         fill(z, |i| {
             let coarse = match cells[i] {
                 u32::MAX => 0.0,
-                c if m == 1 => COARSE_WEIGHT * first.x[c as usize],
-                c => {
-                    let x = &first.x[c as usize * m..(c as usize + 1) * m];
-                    let linear: f64 = (1..m).map(|k| basis[i][k - 1] * x[k]).sum();
-                    COARSE_WEIGHT * (x[0] + linear)
-                }
+                c => COARSE_WEIGHT * first.x[c as usize],
             };
             inv[i] * r[i] + coarse
         });

@@ -660,121 +660,47 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
         }
     }
 
-    fn linear_basis(&self, i: usize) -> [f64; D] {
-        let grid = self.nb.grid();
-        std::array::from_fn(|d| {
-            let x = F64s::splat(self.p.pos[d][i]);
-            grid.offset_in_block_along_lanes(d, x, grid.block_along_lanes(d, x))
-                .to_array()[0]
-        })
-    }
-
     fn add_coarse_row(&self, i: usize, row: &mut [f64]) -> f64 {
         // Interior rows: a_ii = Σ w, a_ij = −w; the other rows are not aggregated.
         debug_assert_eq!(self.roles[i], Role::Interior, "row {i} is not aggregated");
         let (grid, p) = (self.nb.grid(), self.p);
         let block_i: [F64s; D] =
-            std::array::from_fn(|d| grid.block_along_lanes(d, F64s::splat(p.pos[d][i])));
-        let (one, three) = (F64s::ONE, F64s::splat(3.0));
+            std::array::from_fn(|d| F64s::splat(grid.block_along(d, p.pos[d][i]) as f64));
+        let (centre, one, three) = (stencil_slot([0; D]), F64s::ONE, F64s::splat(3.0));
         let constants = self.row_constants(i);
         let mut diagonal = Sum::ZERO;
-        let mut couplings = StencilSums::new();
         self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
             let w = self.fluid_weights(&constants, l);
             diagonal += w;
-            // Each lane's block, its offset from row i's, its slot in the 3^D stencil (x
-            // fastest) and whether it lies within it, computed in lanes from the absolute
-            // positions: `stencil_slot` in lanes. A coupling across a periodic boundary joins
-            // blocks at the two ends of the grid, outside the 3^D stencil: the coarse levels
-            // leave it out (their row keeps its diagonal), which only weakens the
-            // preconditioner near that boundary.
-            let x: [F64s; D] = std::array::from_fn(|d| l.load(&p.pos[d]));
-            let block: [F64s; D] = std::array::from_fn(|d| grid.block_along_lanes(d, x[d]));
-            let (mut slot, mut within) = (F64s::ZERO, F64s::ONE);
+            // Each lane's block offset from row i's, its slot in the 3^D stencil (x fastest)
+            // and whether it lies within it, computed in lanes from the absolute positions.
+            // `stencil_slot` in lanes.
+            let offset: [F64s; D] =
+                std::array::from_fn(|d| grid.block_along_lanes(d, l.load(&p.pos[d])) - block_i[d]);
+            let (mut slot, mut within) = (F64s::ZERO, u32::MAX);
             for d in (0..D).rev() {
-                let offset = block[d] - block_i[d];
-                within = offset.abs().simd_le(one).select(within, F64s::ZERO);
-                slot = slot.mul_add(three, offset + one);
+                within &= offset[d].abs().simd_le(one).to_bitmask();
+                slot = slot.mul_add(three, offset[d] + one);
             }
-            // w where j's row is interior and in the stencil, 0 elsewhere (exact products).
-            let coupled = w * within * self.interior_lanes(l);
-            let phi: [F64s; D] =
-                std::array::from_fn(|d| grid.offset_in_block_along_lanes(d, x[d], block[d]));
-            couplings.add(slot, coupled, phi);
+            let (w, slot) = (w.to_array(), slot.to_array());
+            for (k, w) in w.into_iter().enumerate() {
+                if w == 0.0 {
+                    continue;
+                }
+                row[centre] += w;
+                // A coupling across a periodic boundary joins blocks at the two ends of the
+                // grid, outside the 3^D stencil: the coarse levels leave it out (their row keeps
+                // its diagonal), which only weakens the preconditioner near that boundary.
+                if within >> k & 1 == 1 && self.roles[l.j0 + k] == Role::Interior {
+                    debug_assert_eq!(
+                        slot[k] as usize,
+                        stencil_slot::<D>(std::array::from_fn(|d| offset[d].to_array()[k] as i64))
+                    );
+                    row[slot[k] as usize] -= w;
+                }
+            }
         });
-        // The diagonal's a_ii φ_l(x_i), at the centre slot.
-        let (a_ii, phi_i) = (diagonal.total(), self.linear_basis(i));
-        let centre = stencil_slot([0; D]) * (1 + D);
-        row[centre] += a_ii;
-        for d in 0..D {
-            row[centre + 1 + d] += a_ii * phi_i[d];
-        }
-        couplings.subtract_from(row, 1 + D);
         interior_diagonal(diagonal)
-    }
-}
-
-impl<const D: usize> PressureOperator<'_, D> {
-    /// 1 in the lanes of `l` whose rows are interior rows, 0 in the others.
-    #[inline(always)]
-    fn interior_lanes(&self, l: &Lanes<D>) -> F64s {
-        F64s::from(std::array::from_fn(|k| {
-            f64::from(u8::from(self.roles.get(l.j0 + k) == Some(&Role::Interior)))
-        }))
-    }
-}
-
-/// A row's couplings to the 3^D stencil's blocks times the neighbours' basis (1, φ_1 … φ_D),
-/// summed in lanes: each block's sums take the lanes of a chunk that fall in it, so a chunk
-/// costs a masked sum per block it touches (one or two) instead of scattered adds per lane.
-struct StencilSums {
-    /// [slot][l]: Σ w φ_l over the lanes in the slot, for the largest stencil (3³ slots, 1 + 3
-    /// functions).
-    sums: [[Sum; 4]; 27],
-    /// Bit s set: slot s holds a lane.
-    touched: u32,
-}
-
-impl StencilSums {
-    fn new() -> Self {
-        Self {
-            sums: [[Sum::ZERO; 4]; 27],
-            touched: 0,
-        }
-    }
-
-    /// Adds each lane of `w` that is not zero, times the basis (1, `phi`), to its slot
-    /// `slot` (whole numbers, in lanes).
-    #[inline(always)]
-    fn add<const D: usize>(&mut self, slot: F64s, w: F64s, phi: [F64s; D]) {
-        let slots = slot.to_array();
-        let mut lanes = w.simd_ne(F64s::ZERO).to_bitmask();
-        while lanes != 0 {
-            let s = slots[lanes.trailing_zeros() as usize];
-            let same = slot.simd_eq(F64s::splat(s));
-            lanes &= !same.to_bitmask();
-            let s = s as usize;
-            let w = same.select(w, F64s::ZERO);
-            let sums = &mut self.sums[s];
-            sums[0] += w;
-            for d in 0..D {
-                sums[1 + d] = sums[1 + d].mul_add(w, phi[d]);
-            }
-            self.touched |= 1 << s;
-        }
-    }
-
-    /// row[s m + l] −= the sum of slot s and function l (m functions), for every slot that
-    /// holds a lane, in slot order.
-    fn subtract_from(&self, row: &mut [f64], m: usize) {
-        let mut touched = self.touched;
-        while touched != 0 {
-            let s = touched.trailing_zeros() as usize;
-            for (l, sum) in self.sums[s][..m].iter().enumerate() {
-                row[s * m + l] -= sum.total();
-            }
-            touched &= touched - 1;
-        }
     }
 }
 

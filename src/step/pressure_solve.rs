@@ -263,7 +263,7 @@ impl<const D: usize> Stage<D> for PressureSolve<D> {
             String::new()
         };
         format!(
-            "Eq. (6): the projection's source −(ρ0/Δt)(∇·u* − (Δt/2)∂_a u_b ∂_b u_a){}, the divergence at the midpoint of the drift; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks, a constant and D linear functions per block on its first level), warm start{density}",
+            "Eq. (6): the projection's source −(ρ0/Δt)(∇·u* − (Δt/2)∂_a u_b ∂_b u_a){}, the divergence at the midpoint of the drift; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start{density}",
             if set.effects.kernel_correction { " (corrected by L_i)" } else { "" },
             match set.ghost_pressure {
                 GhostPressure::Hydrostatic => "Neumann ghosts of the fluid pressure, P_b = P_i + ρ0 g·N_b r_bi",
