@@ -320,6 +320,10 @@ impl Aggregated<2> for Spray {
         [CELLS, 1]
     }
 
+    fn periodic(&self) -> [bool; 2] {
+        [false; 2]
+    }
+
     fn aggregate(&self, i: usize) -> Option<usize> {
         Some(i / 2)
     }
@@ -370,4 +374,113 @@ fn multigrid_takes_cells_whose_rows_couple_to_nothing() {
             b[i]
         );
     }
+}
+
+/// Rows with the structure of the PPE's around a periodic axis: `2 CELLS` unknowns on a ring,
+/// two per cell of a periodic row of cells, unknown i coupled to i ± 1 (around the ring) with
+/// weight 1 and a_ii = 2; unknown `fixed`, if any, a row of the identity outside every
+/// aggregate (a free-surface or reference particle), whose neighbours' rows then sum above
+/// zero on the coarse levels.
+struct Ring {
+    fixed: Option<usize>,
+}
+
+impl Ring {
+    fn neighbours(i: usize) -> [usize; 2] {
+        let n = 2 * CELLS;
+        [(i + n - 1) % n, (i + 1) % n]
+    }
+}
+
+impl LinearOperator for Ring {
+    fn len(&self) -> usize {
+        2 * CELLS
+    }
+
+    fn apply(&self, x: &[f64], y: &mut [f64]) {
+        for i in 0..self.len() {
+            y[i] = if self.fixed == Some(i) {
+                x[i]
+            } else {
+                let [l, r] = Self::neighbours(i);
+                2.0 * x[i] - x[l] - x[r]
+            };
+        }
+    }
+
+    fn diagonal(&self, d: &mut [f64]) {
+        for (i, d) in d.iter_mut().enumerate() {
+            *d = if self.fixed == Some(i) { 1.0 } else { 2.0 };
+        }
+    }
+}
+
+impl Aggregated<2> for Ring {
+    fn dims(&self) -> [usize; 2] {
+        [CELLS, 1]
+    }
+
+    fn periodic(&self) -> [bool; 2] {
+        [true, false]
+    }
+
+    fn aggregate(&self, i: usize) -> Option<usize> {
+        (self.fixed != Some(i)).then_some(i / 2)
+    }
+
+    fn add_coarse_row(&self, i: usize, row: &mut [f64]) -> f64 {
+        row[stencil_slot([0, 0])] += 2.0;
+        for j in Self::neighbours(i)
+            .into_iter()
+            .filter(|&j| self.fixed != Some(j))
+        {
+            // The neighbour's cell one cell away around the ring.
+            let offset = match (j / 2) as i64 - (i / 2) as i64 {
+                o if o > 1 => o - CELLS as i64,
+                o if o < -1 => o + CELLS as i64,
+                o => o,
+            };
+            row[stencil_slot([offset, 0])] -= 1.0;
+        }
+        2.0
+    }
+}
+
+/// The coarse levels couple the cells at the two ends of a periodic axis: on a ring with no
+/// fixed unknown every row of level 1 sums to zero (one singular region, every unknown), with
+/// one it is anchored, and the multigrid solves it.
+#[test]
+fn multigrid_couples_cells_across_a_periodic_boundary() {
+    let mut multigrid = Multigrid::<2>::default();
+    multigrid.setup(&Ring { fixed: None }).unwrap();
+    assert_eq!(
+        multigrid.unanchored_regions(),
+        vec![(0..2 * CELLS).collect::<Vec<_>>()]
+    );
+    let a = Ring { fixed: Some(0) };
+    multigrid.setup(&a).unwrap();
+    assert!(multigrid.unanchored_regions().is_empty());
+    let b: Vec<f64> = (0..a.len())
+        .map(|i| {
+            if i == 0 {
+                0.0
+            } else {
+                ((i * 13 % 5) as f64 - 2.0) / 2.0
+            }
+        })
+        .collect();
+    let mut x = vec![0.0; a.len()];
+    let params = SolverParams {
+        tolerance: 1e-10,
+        max_iterations: 500,
+    };
+    let info = BiCgStab::default()
+        .solve(&a, &mut multigrid, &b, &mut x, params)
+        .unwrap();
+    assert!(info.converged, "{info:?}");
+    let mut ax = vec![0.0; a.len()];
+    a.apply(&x, &mut ax);
+    let residual = ax.iter().zip(&b).map(|(y, b)| (y - b).powi(2)).sum::<f64>();
+    let norm = b.iter().map(|b| b * b).sum::<f64>();
+    assert!(residual.sqrt() <= 1e-9 * norm.sqrt(), "{residual} {norm}");
 }

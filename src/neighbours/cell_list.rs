@@ -150,9 +150,25 @@ impl<const D: usize> CellList<D> {
     }
 
     /// Blocks of `subdivision(d)` cells per axis, each at least one support wide: the
-    /// aggregates of the multigrid.
+    /// aggregates of the multigrid. Along a periodic axis the last cells of the period, fewer
+    /// than a block, join the block before them: a block one support wide or more then meets
+    /// only the adjacent blocks, across the boundary too.
     pub fn blocks(&self) -> [usize; D] {
-        std::array::from_fn(|d| self.dims[d].div_ceil(subdivision(d)))
+        std::array::from_fn(|d| match self.period[d] {
+            Some(_) => self.dims[d] / subdivision(d),
+            None => self.dims[d].div_ceil(subdivision(d)),
+        })
+    }
+
+    /// Whether each axis is periodic.
+    pub fn periodic(&self) -> [bool; D] {
+        self.period.map(|p| p.is_some())
+    }
+
+    /// The block along axis d of cell `k` along it (`blocks`).
+    #[inline]
+    fn block_of_cell(&self, d: usize, k: usize) -> usize {
+        (k / subdivision(d)).min(self.blocks()[d] - 1)
     }
 
     /// The block (linear index, x fastest, in a grid of `blocks()`) of particle k of the sorted
@@ -162,7 +178,7 @@ impl<const D: usize> CellList<D> {
         let blocks = self.blocks();
         let (mut rest, mut lin, mut stride) = (self.sorted_cell[k] as usize, 0, 1);
         for d in 0..D {
-            lin += (rest % self.dims[d]) / subdivision(d) * stride;
+            lin += self.block_of_cell(d, rest % self.dims[d]) * stride;
             rest /= self.dims[d];
             stride *= blocks[d];
         }
@@ -173,18 +189,19 @@ impl<const D: usize> CellList<D> {
     /// `block_of_sorted` counts them.
     #[inline]
     pub fn block_along(&self, d: usize, x: f64) -> i64 {
-        self.cell_along(d, x) / subdivision(d) as i64
+        self.block_of_cell(d, self.cell_along(d, x) as usize) as i64
     }
 
     /// `block_along` of the coordinates `x` of a chunk's lanes, as whole numbers: the same
-    /// subtraction, product, floor and clamp, and the division by the subdivision (4 or 2) is
+    /// subtraction, product, floor and clamps, and the division by the subdivision (4 or 2) is
     /// exact as a product; the two agree for every point at or above the grid's origin, as
     /// every particle is (`sort` refuses one outside, `wrap` keeps periodic ones inside).
     #[inline(always)]
     pub fn block_along_lanes(&self, d: usize, x: F64s) -> F64s {
         let cell = ((x - F64s::splat(self.origin[d])) * F64s::splat(self.inv_width[d])).floor();
         let cell = cell.fast_min(F64s::splat((self.dims[d] - 1) as f64));
-        (cell * F64s::splat(1.0 / subdivision(d) as f64)).floor()
+        let block = (cell * F64s::splat(1.0 / subdivision(d) as f64)).floor();
+        block.fast_min(F64s::splat((self.blocks()[d] - 1) as f64))
     }
 
     /// The per-particle array of the grid: the cell of each particle in the sorted order.

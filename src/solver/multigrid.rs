@@ -5,7 +5,8 @@
 //! block of the cell list (`CellList::blocks`, each at least one kernel support wide): the
 //! particles of a block form one aggregate, interpolation is piecewise constant, and the coarse
 //! operator is the Galerkin product A₁ = Pᵀ A P, a 3^D-point stencil since a block is one
-//! support wide. Each further level merges 2^D cells, which keeps the 3^D stencil. The coarsest
+//! support wide; along a periodic axis the stencil wraps around, the first and last cells being
+//! adjacent. Each further level merges 2^D cells, which keeps the 3^D stencil. The coarsest
 //! level (at most `COARSEST` cells) is relaxed by many sweeps; the others are smoothed by damped
 //! Jacobi, `SMOOTHING_SWEEPS` sweeps before and after their coarse correction, which
 //! piecewise-constant interpolation leaves too small on smooth errors and is scaled by
@@ -61,6 +62,9 @@ const PARALLEL_CELLS: usize = 8192;
 /// (x fastest): the fine level of the multigrid.
 pub trait Aggregated<const D: usize>: LinearOperator {
     fn dims(&self) -> [usize; D];
+    /// Whether each axis of the grid is periodic: its first and last cells are adjacent, and
+    /// `add_coarse_row` puts a coupling across the boundary in the slot of that adjacency.
+    fn periodic(&self) -> [bool; D];
     /// The cell of unknown i, or None for an unknown held fixed (a Dirichlet row of the
     /// identity, outside every aggregate).
     fn aggregate(&self, i: usize) -> Option<usize>;
@@ -78,21 +82,78 @@ pub fn stencil_slot<const D: usize>(offset: [i64; D]) -> usize {
         .fold(0, |s, d| 3 * s + (offset[d] + 1) as usize)
 }
 
-/// The offset of cell `to` from cell `from` in a grid of `dims` cells, if they are neighbours.
-fn cell_offset<const D: usize>(dims: [usize; D], from: usize, to: usize) -> [i64; D] {
-    let (mut a, mut b) = (from, to);
-    std::array::from_fn(|d| {
-        let o = (b % dims[d]) as i64 - (a % dims[d]) as i64;
-        a /= dims[d];
-        b /= dims[d];
-        o
-    })
+/// The grid of a structured level: its cells per axis (x fastest in the linear index) and
+/// which axes are periodic.
+#[derive(Clone, Copy, Debug)]
+struct Grid<const D: usize> {
+    dims: [usize; D],
+    periodic: [bool; D],
+}
+
+impl<const D: usize> Grid<D> {
+    fn cells(&self) -> usize {
+        self.dims.iter().product()
+    }
+
+    /// The grid of 2^D cells merged (the last cell along an odd axis alone).
+    fn coarser(&self) -> Self {
+        Self {
+            dims: self.dims.map(|n| n.div_ceil(2)),
+            periodic: self.periodic,
+        }
+    }
+
+    /// The cell of the coarser grid `coarse` holding cell `c`.
+    fn parent(&self, coarse: &Self, c: usize) -> usize {
+        let (mut rest, mut lin, mut stride) = (c, 0, 1);
+        for d in 0..D {
+            lin += (rest % self.dims[d]) / 2 * stride;
+            rest /= self.dims[d];
+            stride *= coarse.dims[d];
+        }
+        lin
+    }
+
+    /// The linear index of cell `c` moved by `offset`, if inside the grid: along a periodic
+    /// axis the move wraps around.
+    fn neighbour(&self, c: usize, offset: [i64; D]) -> Option<usize> {
+        let (mut rest, mut lin, mut stride) = (c, 0usize, 1usize);
+        for d in 0..D {
+            let n = self.dims[d] as i64;
+            let mut k = (rest % self.dims[d]) as i64 + offset[d];
+            rest /= self.dims[d];
+            if self.periodic[d] {
+                k = k.rem_euclid(n);
+            } else if k < 0 || k >= n {
+                return None;
+            }
+            lin += k as usize * stride;
+            stride *= self.dims[d];
+        }
+        Some(lin)
+    }
+
+    /// The offset of cell `to` from its neighbour `from`, each component −1, 0 or 1: along a
+    /// periodic axis of n cells the last cell is one before the first.
+    fn offset(&self, from: usize, to: usize) -> [i64; D] {
+        let (mut a, mut b) = (from, to);
+        std::array::from_fn(|d| {
+            let n = self.dims[d] as i64;
+            let mut o = (b % self.dims[d]) as i64 - (a % self.dims[d]) as i64;
+            a /= self.dims[d];
+            b /= self.dims[d];
+            if self.periodic[d] && o.abs() > 1 {
+                o -= o.signum() * n;
+            }
+            o
+        })
+    }
 }
 
 /// The 3^D-point stencils of one structured level, one row of `3^D` coefficients per cell of
 /// its grid, x fastest: the form the Galerkin products are summed in.
 struct Stencils<const D: usize> {
-    dims: [usize; D],
+    grid: Grid<D>,
     rows: Vec<f64>,
 }
 
@@ -100,11 +161,10 @@ impl<const D: usize> Stencils<D> {
     const WIDTH: usize = 3usize.pow(D as u32);
     const CENTRE: usize = (Self::WIDTH - 1) / 2;
 
-    fn new(dims: [usize; D]) -> Self {
-        let n: usize = dims.iter().product();
+    fn new(grid: Grid<D>) -> Self {
         Self {
-            dims,
-            rows: vec![0.0; n * Self::WIDTH],
+            grid,
+            rows: vec![0.0; grid.cells() * Self::WIDTH],
         }
     }
 
@@ -123,7 +183,7 @@ impl<const D: usize> Stencils<D> {
         let row = self.row(c);
         for_each_offset::<D>(|slot, offset| {
             if row[slot] != 0.0 {
-                if let Some(n) = neighbour(self.dims, c, offset) {
+                if let Some(n) = self.grid.neighbour(c, offset) {
                     f(n, row[slot]);
                 }
             }
@@ -135,7 +195,7 @@ impl<const D: usize> Stencils<D> {
 /// others (air, dry walls: most of a tank that is mostly empty) would have the identity row
 /// and a zero right-hand side, solution and residual, so they are left out.
 struct Level<const D: usize> {
-    dims: [usize; D],
+    grid: Grid<D>,
     /// Grid index of each active cell, ascending.
     cells: Vec<u32>,
     /// The operator in compressed rows over the active cells: row k's coefficients are
@@ -162,7 +222,7 @@ impl<const D: usize> Level<D> {
     fn of(stencils: &Stencils<D>, cells: Vec<u32>) -> Self {
         let centre = Stencils::<D>::CENTRE;
         let mut level = Self {
-            dims: stencils.dims,
+            grid: stencils.grid,
             start: vec![0],
             column: Vec::new(),
             value: Vec::new(),
@@ -203,7 +263,7 @@ impl<const D: usize> Level<D> {
 
     /// Cells of the level's grid, active or not.
     fn grid_cells(&self) -> usize {
-        self.dims.iter().product()
+        self.grid.cells()
     }
 
     /// The active index of grid cell c, if active.
@@ -233,21 +293,22 @@ impl<const D: usize> Level<D> {
 
     /// The next coarser level: 2^D cells merged, A_c = Pᵀ A P. Sets this level's `parent`.
     fn coarsen(&mut self) -> Level<D> {
-        let mut stencils = Stencils::new(self.dims.map(|n| n.div_ceil(2)));
+        let (fine, coarse) = (self.grid, self.grid.coarser());
+        let mut stencils = Stencils::new(coarse);
         let w = Stencils::<D>::WIDTH;
         for k in 0..self.len() {
-            let parent = parent_cell(self.dims, stencils.dims, self.cells[k] as usize);
+            let parent = fine.parent(&coarse, self.cells[k] as usize);
             for e in self.start[k] as usize..self.start[k + 1] as usize {
                 let n = self.cells[self.column[e] as usize] as usize;
-                let to = parent_cell(self.dims, stencils.dims, n);
-                let s = stencil_slot(cell_offset(stencils.dims, parent, to));
+                let to = fine.parent(&coarse, n);
+                let s = stencil_slot(coarse.offset(parent, to));
                 stencils.rows[parent * w + s] += self.value[e];
             }
         }
         let mut parents: Vec<u32> = self
             .cells
             .iter()
-            .map(|&c| parent_cell(self.dims, stencils.dims, c as usize) as u32)
+            .map(|&c| fine.parent(&coarse, c as usize) as u32)
             .collect();
         parents.sort_unstable();
         parents.dedup();
@@ -256,7 +317,7 @@ impl<const D: usize> Level<D> {
             .cells
             .iter()
             .map(|&c| {
-                let p = parent_cell(self.dims, coarse.dims, c as usize);
+                let p = fine.parent(&coarse.grid, c as usize);
                 coarse
                     .active_index(p)
                     .expect("an active cell's parent is active") as u32
@@ -264,21 +325,6 @@ impl<const D: usize> Level<D> {
             .collect();
         coarse
     }
-}
-
-/// The linear index of cell `c` moved by `offset` in a grid of `dims` cells, if inside it.
-fn neighbour<const D: usize>(dims: [usize; D], c: usize, offset: [i64; D]) -> Option<usize> {
-    let (mut rest, mut lin, mut stride) = (c, 0usize, 1usize);
-    for d in 0..D {
-        let k = (rest % dims[d]) as i64 + offset[d];
-        rest /= dims[d];
-        if k < 0 || k >= dims[d] as i64 {
-            return None;
-        }
-        lin += k as usize * stride;
-        stride *= dims[d];
-    }
-    Some(lin)
 }
 
 /// Calls `f(slot, offset)` for each of the 3^D stencil offsets.
@@ -292,17 +338,6 @@ fn for_each_offset<const D: usize>(mut f: impl FnMut(usize, [i64; D])) {
         });
         f(slot, offset);
     }
-}
-
-/// The cell of the coarser grid `coarse` holding cell `c` of the grid `fine`.
-fn parent_cell<const D: usize>(fine: [usize; D], coarse: [usize; D], c: usize) -> usize {
-    let (mut rest, mut lin, mut stride) = (c, 0, 1);
-    for d in 0..D {
-        lin += (rest % fine[d]) / 2 * stride;
-        rest /= fine[d];
-        stride *= coarse[d];
-    }
-    lin
 }
 
 /// The set of union–find element k (path halving).
@@ -437,7 +472,10 @@ impl<const D: usize> Multigrid<D> {
             a.aggregate(i).map_or(u32::MAX, |c| c as u32)
         });
 
-        let mut first = Stencils::new(a.dims());
+        let mut first = Stencils::new(Grid {
+            dims: a.dims(),
+            periodic: a.periodic(),
+        });
         let members = Members::of(&self.fine_cell, first.cells());
         // Each cell's stencil row is the sum of its unknowns' rows, in index order; each row
         // gives its own a_ii on the way.

@@ -653,6 +653,10 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
         self.nb.grid().blocks()
     }
 
+    fn periodic(&self) -> [bool; D] {
+        self.nb.grid().periodic()
+    }
+
     fn aggregate(&self, i: usize) -> Option<usize> {
         match self.roles[i] {
             Role::Interior => Some(self.nb.grid().block_of_sorted(i)),
@@ -667,6 +671,11 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
         let block_i: [F64s; D] =
             std::array::from_fn(|d| F64s::splat(grid.block_along(d, p.pos[d][i]) as f64));
         let (centre, one, three) = (stencil_slot([0; D]), F64s::ONE, F64s::splat(3.0));
+        // Along a periodic axis of n blocks (n ≥ 3) a neighbour across the boundary lies
+        // n − 1 blocks away in the grid and one block away in the period.
+        let (periodic, blocks) = (grid.periodic(), grid.blocks());
+        let period: [Option<F64s>; D] =
+            std::array::from_fn(|d| periodic[d].then(|| F64s::splat(blocks[d] as f64)));
         let constants = self.row_constants(i);
         let mut diagonal = Sum::ZERO;
         self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
@@ -675,8 +684,13 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
             // Each lane's block offset from row i's, its slot in the 3^D stencil (x fastest)
             // and whether it lies within it, computed in lanes from the absolute positions.
             // `stencil_slot` in lanes.
-            let offset: [F64s; D] =
-                std::array::from_fn(|d| grid.block_along_lanes(d, l.load(&p.pos[d])) - block_i[d]);
+            let offset: [F64s; D] = std::array::from_fn(|d| {
+                let o = grid.block_along_lanes(d, l.load(&p.pos[d])) - block_i[d];
+                match period[d] {
+                    Some(n) => o - (o.simd_gt(one) & n) + (o.simd_lt(-one) & n),
+                    None => o,
+                }
+            });
             let (mut slot, mut within) = (F64s::ZERO, u32::MAX);
             for d in (0..D).rev() {
                 within &= offset[d].abs().simd_le(one).to_bitmask();
@@ -688,9 +702,6 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
                     continue;
                 }
                 row[centre] += w;
-                // A coupling across a periodic boundary joins blocks at the two ends of the
-                // grid, outside the 3^D stencil: the coarse levels leave it out (their row keeps
-                // its diagonal), which only weakens the preconditioner near that boundary.
                 if within >> k & 1 == 1 && self.roles[l.j0 + k] == Role::Interior {
                     debug_assert_eq!(
                         slot[k] as usize,
