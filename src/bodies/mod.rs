@@ -50,11 +50,15 @@ pub struct RigidState {
     /// still: held still over the next step, as long as its contacts can hold it
     /// (`Bodies::resolve_contacts`).
     pub resting: bool,
+    /// Whether the body moved freely over the last step in reach of the fluid or a wall: its
+    /// `force` and `torque` are then the fluid's on it as it moves, from which the next step
+    /// extrapolates (`Bodies::advance`).
+    pub wet: bool,
 }
 
 impl RigidState {
-    /// f64s of a state in a checkpoint: `resting` is the last, 1 or 0.
-    pub const LEN: usize = 20;
+    /// f64s of a state in a checkpoint: `resting` and `wet` are the last two, 1 or 0.
+    pub const LEN: usize = 21;
 
     pub fn to_array(&self) -> [f64; Self::LEN] {
         let mut a = [0.0; Self::LEN];
@@ -72,11 +76,12 @@ impl RigidState {
             k += part.len();
         }
         a[k] = f64::from(u8::from(self.resting));
+        a[k + 1] = f64::from(u8::from(self.wet));
         a
     }
 
-    /// The state of `a`, one of `to_array` or one of the 19 f64s that checkpoints held before
-    /// `resting` (not resting).
+    /// The state of `a`, one of `to_array` or one of the 20 or 19 f64s that checkpoints held
+    /// before `wet` (not wet) and before `resting` (not resting).
     pub fn from_array(a: &[f64]) -> Self {
         let v = |k: usize| [a[k], a[k + 1], a[k + 2]];
         Self {
@@ -87,6 +92,7 @@ impl RigidState {
             force: v(13),
             torque: v(16),
             resting: a.get(19) == Some(&1.0),
+            wet: a.get(20) == Some(&1.0),
         }
     }
 }
@@ -351,6 +357,7 @@ impl Bodies {
                         force: [0.0; 3],
                         torque: [0.0; 3],
                         resting: false,
+                        wet: false,
                     },
                 };
                 // A prescribed body starts moving as its trajectory does at t = 0.
@@ -382,6 +389,16 @@ impl Bodies {
             held_in_solve: None,
             gravity: std::array::from_fn(|d| scene.gravity.get(d).copied().unwrap_or(0.0)),
         }
+    }
+    /// The first time after `t` at which a body is let go (`RigidBody::release`): the run lands
+    /// a step on it, as on a frame time, so that the body moves freely from that time and not
+    /// from the end of the step across it.
+    pub fn next_release_after(&self, t: f64) -> Option<f64> {
+        self.bodies
+            .iter()
+            .filter_map(|b| b.release)
+            .filter(|&r| r > t)
+            .min_by(f64::total_cmp)
     }
 
     pub fn is_empty(&self) -> bool {
@@ -440,11 +457,11 @@ impl Bodies {
             .collect()
     }
 
-    /// Restores the states written by `states` (or by a checkpoint of 19 f64s a state, before
-    /// `resting`); false if `states` does not hold one per body.
+    /// Restores the states written by `states` (or by a checkpoint of 20 or 19 f64s a state,
+    /// before `wet` and before `resting`); false if `states` does not hold one per body.
     pub fn restore(&mut self, states: &[f64]) -> bool {
         let count = self.bodies.len();
-        let Some(len) = [RigidState::LEN, RigidState::LEN - 1]
+        let Some(len) = [RigidState::LEN, RigidState::LEN - 1, RigidState::LEN - 2]
             .into_iter()
             .find(|len| states.len() == count * len)
         else {
@@ -465,7 +482,16 @@ impl Bodies {
     /// what the fluid's force and `load` (the body forces on its own masses: its weight and
     /// external force, in a moving container the frame's) would give it over the step from
     /// rest; its contacts then hold it or let it go (`resolve_contacts`, after every body has
-    /// moved).
+    /// moved). `wet`: its particles were in reach of the fluid or a wall over the step.
+    ///
+    /// The step's solve gives the fluid's force F on a free body at the configuration of the
+    /// step's start, and the body's added mass implicitly. Where the body was wet over this step
+    /// and the last, the momentum balance takes the force at the middle of the step,
+    /// extrapolated from the last two, F + (F − F_last)/2 (second-order Adams–Bashforth, the
+    /// change per step): as a body sinks or rises through the surface its buoyancy changes with
+    /// its position, and the force of the step's start lags it by half a step
+    /// (docs/bodies.md, "The coupling"). The same for the torque. A force that starts or jumps
+    /// (the release, the entry into the water) is not extrapolated.
     #[allow(clippy::too_many_arguments)]
     pub fn advance(
         &mut self,
@@ -474,6 +500,7 @@ impl Bodies {
         angular_impulse: Vec3,
         applied: [Vec3; 2],
         load: [Vec3; 2],
+        wet: bool,
         time: f64,
         dt: f64,
     ) {
@@ -495,6 +522,7 @@ impl Bodies {
                 force,
                 torque,
                 resting: s.resting,
+                wet: false,
             };
             if s.resting {
                 body.state.velocity =
@@ -504,12 +532,24 @@ impl Bodies {
             }
             return;
         }
-        // Eq. (14): the momentum balance.
+        // Eq. (14)–(15): the momentum balances, with the fluid's force and torque at the middle
+        // of the step where the last step's are known.
+        let half_change = |now: Vec3, last: Vec3| -> Vec3 {
+            if wet && s.wet {
+                std::array::from_fn(|d| 0.5 * (now[d] - last[d]) * dt)
+            } else {
+                [0.0; 3]
+            }
+        };
+        let (extra, extra_angular) = (half_change(force, s.force), half_change(torque, s.torque));
         body.state = RigidState {
-            velocity: std::array::from_fn(|d| s.velocity[d] + impulse[d] / body.mass),
-            angular_momentum: std::array::from_fn(|d| s.angular_momentum[d] + angular_impulse[d]),
+            velocity: std::array::from_fn(|d| s.velocity[d] + (impulse[d] + extra[d]) / body.mass),
+            angular_momentum: std::array::from_fn(|d| {
+                s.angular_momentum[d] + angular_impulse[d] + extra_angular[d]
+            }),
             force,
             torque,
+            wet,
             ..s
         };
         body.drift(s.velocity, dt);
@@ -622,7 +662,7 @@ pub fn rigid_velocity(velocity: Vec3, omega: Vec3, arm: Vec3) -> Vec3 {
 mod tests {
     use super::*;
 
-    fn state(resting: bool) -> RigidState {
+    fn state(resting: bool, wet: bool) -> RigidState {
         RigidState {
             centre: [0.1, 0.2, 0.3],
             orientation: Quaternion([0.6, 0.0, 0.0, 0.8]),
@@ -631,18 +671,23 @@ mod tests {
             force: [7.0, 8.0, 9.0],
             torque: [10.0, 11.0, 12.0],
             resting,
+            wet,
         }
     }
 
     #[test]
     fn a_state_reads_back_from_its_checkpoint_array_and_an_older_one_rests_not() {
-        for resting in [false, true] {
-            let a = state(resting).to_array();
-            assert_eq!(RigidState::from_array(&a), state(resting));
-            // A checkpoint written before `resting` held the first 19.
+        for (resting, wet) in [(false, false), (true, false), (false, true)] {
+            let a = state(resting, wet).to_array();
+            assert_eq!(RigidState::from_array(&a), state(resting, wet));
+            // A checkpoint written before `wet` held the first 20, before `resting` 19.
             assert_eq!(
                 RigidState::from_array(&a[..RigidState::LEN - 1]),
-                state(false)
+                state(resting, false)
+            );
+            assert_eq!(
+                RigidState::from_array(&a[..RigidState::LEN - 2]),
+                state(false, false)
             );
         }
     }

@@ -302,6 +302,19 @@ impl<'a, const D: usize> Driver<'a, D> {
         }
     }
 
+    /// The time the next step goes towards: the next frame's, or a body's release before it
+    /// (`Bodies::next_release_after`). A release within `FRAME_TIME_ROUNDING` intervals of the
+    /// frame's time shares its landing, the later of the two, so that no step is a sliver.
+    fn next_target(&self) -> f64 {
+        let (frame, _) = self.next_frame();
+        let rounding = FRAME_TIME_ROUNDING * self.scene.output_interval;
+        match self.sim.bodies.next_release_after(self.sim.time) {
+            Some(release) if release < frame - rounding => release,
+            Some(release) if release <= frame + rounding => release.max(frame),
+            _ => frame,
+        }
+    }
+
     /// Writes a frame when the simulation has reached the next frame time.
     fn write_frame_if_due(&mut self) -> Result<(), RunError> {
         let (target, scheduled) = self.next_frame();
@@ -421,8 +434,7 @@ impl<'a, const D: usize> Driver<'a, D> {
             Progress::new(self.sim.time, self.sim.step, self.requested_end, self.quiet);
         let (mut steps, mut ppe_total, mut last) = (0u64, 0u64, None);
         while self.sim.time < self.end {
-            let (target, _) = self.next_frame();
-            let step = match self.sim.advance_towards(target) {
+            let step = match self.sim.advance_towards(self.next_target()) {
                 Ok(s) => s,
                 Err(failure) => {
                     self.output.stats.flush()?;

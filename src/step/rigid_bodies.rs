@@ -85,7 +85,9 @@ impl RigidBodies {
                 impulse[b] = applied[b][0].map(|f| f * dt);
                 angular[b] = applied[b][1].map(|t| t * dt);
             }
-            bodies.advance(b, impulse[b], angular[b], applied[b], loads[b], time, dt);
+            bodies.advance(
+                b, impulse[b], angular[b], applied[b], loads[b], touched[b], time, dt,
+            );
         }
         bodies.resolve_contacts(time, dt);
         let poses: Vec<_> = bodies
