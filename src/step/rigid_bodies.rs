@@ -159,7 +159,7 @@ impl<const D: usize> Stage<D> for RigidBodies {
     }
 
     fn describe(&self, _: &StepSettings<D>) -> String {
-        "Eq. (11)–(16): each free body's momentum and angular momentum from its particles' corrected velocities; V, L, the centre (trapezoid) and the orientation quaternion advanced in f64; contact with the container's faces, obstacles and other bodies; a body its contacts stop rests, held still while they hold it; a fixed or prescribed body put where its motion says, the fluid's force on it measured; the particles' velocities and positions set rigidly".into()
+        "Eq. (11)–(16): each free body's momentum and angular momentum from its particles' corrected velocities, the fluid's force and torque taken at the middle of the step (extrapolated from the last two wet steps); V, L, the centre (trapezoid) and the orientation quaternion advanced in f64; contact with the container's faces, obstacles and other bodies; a body its contacts stop rests, held still while they hold it; a fixed or prescribed body put where its motion says, the fluid's force on it measured; the particles' velocities and positions set rigidly".into()
     }
 
     fn arrays(&self) -> Vec<ArraySize> {
