@@ -304,11 +304,12 @@ impl<'a, const D: usize> Driver<'a, D> {
 
     /// The time the next step goes towards: the next frame's, or a body's release before it
     /// (`Bodies::next_release_after`). A release within `FRAME_TIME_ROUNDING` intervals of the
-    /// frame's time shares its landing, the later of the two, so that no step is a sliver.
+    /// frame's time shares its landing, the later of the two, and one as close after the
+    /// present time takes effect at the end of the next step, so that no step is a sliver.
     fn next_target(&self) -> f64 {
         let (frame, _) = self.next_frame();
         let rounding = FRAME_TIME_ROUNDING * self.scene.output_interval;
-        match self.sim.bodies.next_release_after(self.sim.time) {
+        match self.sim.bodies.next_release_after(self.sim.time + rounding) {
             Some(release) if release < frame - rounding => release,
             Some(release) if release <= frame + rounding => release.max(frame),
             _ => frame,
