@@ -97,25 +97,52 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
     (a - b).abs() <= 1e-12 * scale
 }
 
-/// The row vectors of the PPE's interior rows as the free-surface stage sums them, in the
-/// moments' walk (no kernel correction: ĉ_i = c_i), and the fluid volumes.
-fn operator_inputs<const D: usize>(
-    nb: &Neighbours<D>,
-    p: &Particles<D>,
-    nf: usize,
-) -> (Vec<[f64; D]>, Vec<f64>) {
-    let row_vectors = (0..nf)
-        .map(|i| {
-            let mut truncation = LaplacianTruncation::new(p, false, i);
-            sph::support_moments_and(nb, p, i, |l, _, followed| {
-                truncation.add(nb, p, l, followed)
-            });
-            ppe::row_vector(Role::Interior, &truncation, &None)
-        })
-        .collect();
-    let mut fluid_volume = Vec::new();
-    ppe::fluid_volumes(p, nf, &mut fluid_volume);
-    (row_vectors, fluid_volume)
+/// The PPE's rows over the fluid of a block, every one interior: their roles, their row vectors
+/// as the free-surface stage sums them, in the moments' walk (no kernel correction: ĉ_i = c_i),
+/// and the fluid volumes.
+struct InteriorRows<const D: usize> {
+    roles: Vec<Role>,
+    row_vectors: Vec<[f64; D]>,
+    fluid_volume: Vec<f64>,
+}
+
+impl<const D: usize> InteriorRows<D> {
+    fn of(nb: &Neighbours<D>, p: &Particles<D>, nf: usize) -> Self {
+        let row_vectors = (0..nf)
+            .map(|i| {
+                let mut truncation = LaplacianTruncation::new(p, false, i);
+                sph::support_moments_and(nb, p, i, |l, _, followed| {
+                    truncation.add(nb, p, l, followed)
+                });
+                ppe::row_vector(Role::Interior, &truncation, &None)
+            })
+            .collect();
+        let mut fluid_volume = Vec::new();
+        ppe::fluid_volumes(p, nf, &mut fluid_volume);
+        Self {
+            roles: vec![Role::Interior; nf],
+            row_vectors,
+            fluid_volume,
+        }
+    }
+
+    /// The operator of these rows, without gravity or interfaces.
+    fn operator<'a>(
+        &'a self,
+        nb: &'a Neighbours<'a, D>,
+        p: &'a Particles<D>,
+    ) -> PressureOperator<'a, D> {
+        PressureOperator {
+            nb,
+            p,
+            roles: &self.roles,
+            row_vectors: &self.row_vectors,
+            fluid_volume: &self.fluid_volume,
+            gravity: [0.0; D],
+            ghost_force: BodyForce::Uniform([0.0; D]),
+            interfaces: None,
+        }
+    }
 }
 
 /// Each coarse row of the multigrid (`Aggregated::add_coarse_row`) is row i of A summed over
@@ -184,18 +211,9 @@ fn check<const D: usize>(n: i64) {
     let nb = Neighbours::new(&grid, &p.pos, kernel);
     let nf = grid.range_of(Kind::Fluid).end;
     let phi = |j: usize| 3.0 * p.pos[0][j] - 2.0 * p.pos[1][j] + 1.0;
-    let roles = vec![Role::Interior; nf];
-    let (row_vectors, fluid_volume) = operator_inputs(&nb, &p, nf);
-    let op = PressureOperator {
-        nb: &nb,
-        p: &p,
-        roles: &roles,
-        row_vectors: &row_vectors,
-        fluid_volume: &fluid_volume,
-        gravity: [0.0; D],
-        ghost_force: BodyForce::Uniform([0.0; D]),
-        interfaces: None,
-    };
+    let rows = InteriorRows::of(&nb, &p, nf);
+    let (row_vectors, fluid_volume) = (&rows.row_vectors, &rows.fluid_volume);
+    let op = rows.operator(&nb, &p);
     let x: Vec<f64> = (0..nf).map(|i| phi(i) * phi(i)).collect();
     let mut ax = vec![0.0; nf];
     op.apply(&x, &mut ax);
@@ -303,20 +321,9 @@ fn coarse_rows_wrap_around_a_periodic_axis() {
         let (p, grid, kernel) = disordered_block::<D>(n, true);
         let nb = Neighbours::new(&grid, &p.pos, kernel);
         let nf = grid.range_of(Kind::Fluid).end;
-        let roles = vec![Role::Interior; nf];
-        let (row_vectors, fluid_volume) = operator_inputs(&nb, &p, nf);
-        let op = PressureOperator {
-            nb: &nb,
-            p: &p,
-            roles: &roles,
-            row_vectors: &row_vectors,
-            fluid_volume: &fluid_volume,
-            gravity: [0.0; D],
-            ghost_force: BodyForce::Uniform([0.0; D]),
-            interfaces: None,
-        };
+        let rows = InteriorRows::of(&nb, &p, nf);
         assert!(grid.dims()[0] % 4 != 0, "{:?}", grid.dims());
-        check_coarse_rows(&op, nf);
+        check_coarse_rows(&rows.operator(&nb, &p), nf);
     }
     periodic::<2>(16);
     periodic::<3>(12);
