@@ -287,8 +287,9 @@ fn a_continued_3d_run_is_bit_identical_to_one_never_stopped() {
 #[test]
 fn a_continued_run_with_bodies_in_a_rolling_tank_is_bit_identical_to_one_never_stopped() {
     let dir = TempDir::new("ckpt-bodies");
-    // The tank rolls, a paddle moves on a sinusoid beside the floating box, and a heavy box
-    // rests on the floor.
+    // The tank rolls, a paddle moves on a sinusoid beside the floating box until it is let go
+    // at 0.25 s (between two frames, after the stop: the continued run lands on it too), and a
+    // heavy box rests on the floor.
     let edits = [
         ("spacing = 0.005 ", "spacing = 0.02 "),
         (
@@ -297,7 +298,7 @@ fn a_continued_run_with_bodies_in_a_rolling_tank_is_bit_identical_to_one_never_s
         ),
         (
             "density = 500.0                 # [kg/m^3]: s = 0.5",
-            "density = 500.0\n\n[[body]]\nname = \"paddle\"\nshape = \"box\"\nmin = [0.06, 0.2]\nmax = [0.1, 0.4]\ndensity = 1000.0\nmotion = \"prescribed\"\n\n[body.trajectory]\nperiod = 0.5\namplitude = [0.02, 0.0]\nangle = 5.0\n\n[[body]]\nname = \"rester\"\nshape = \"box\"\nmin = [0.8, 0.0]\nmax = [0.88, 0.08]\ndensity = 1500.0\nfriction = 0.5\n",
+            "density = 500.0\n\n[[body]]\nname = \"paddle\"\nshape = \"box\"\nmin = [0.06, 0.2]\nmax = [0.1, 0.4]\ndensity = 1000.0\nmotion = \"prescribed\"\nrelease = 0.25\n\n[body.trajectory]\nperiod = 0.5\namplitude = [0.02, 0.0]\nangle = 5.0\n\n[[body]]\nname = \"rester\"\nshape = \"box\"\nmin = [0.8, 0.0]\nmax = [0.88, 0.08]\ndensity = 1500.0\nfriction = 0.5\n",
         ),
     ];
     let file = scene_file(dir.path(), "floating_box_2d.toml", &edits, 0.1, 2);
