@@ -390,6 +390,7 @@ impl Bodies {
             gravity: std::array::from_fn(|d| scene.gravity.get(d).copied().unwrap_or(0.0)),
         }
     }
+
     /// The first time after `t` at which a body is let go (`RigidBody::release`): the run lands
     /// a step on it, as on a frame time, so that the body moves freely from that time and not
     /// from the end of the step across it.
