@@ -68,9 +68,8 @@ fn disordered_block<const D: usize>(
     if periodic_x {
         (lo[0], periodic[0]) = (0.0, true);
     }
-    let grid = CellList::new(lo, [extent; D], kernel.support(), periodic);
+    let mut grid = CellList::new(lo, [extent; D], kernel.support(), periodic);
     grid.wrap(&mut p.pos);
-    let mut grid = grid;
     let (mut cells, mut order, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
     grid.sort(&p.pos, &p.kind, &mut cells, &mut order).unwrap();
     p.permute(&order, &mut scratch);

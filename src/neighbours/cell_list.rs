@@ -154,10 +154,16 @@ impl<const D: usize> CellList<D> {
     /// than a block, join the block before them: a block one support wide or more then meets
     /// only the adjacent blocks, across the boundary too.
     pub fn blocks(&self) -> [usize; D] {
-        std::array::from_fn(|d| match self.period[d] {
+        std::array::from_fn(|d| self.blocks_along(d))
+    }
+
+    /// `blocks` along axis d alone.
+    #[inline]
+    fn blocks_along(&self, d: usize) -> usize {
+        match self.period[d] {
             Some(_) => self.dims[d] / subdivision(d),
             None => self.dims[d].div_ceil(subdivision(d)),
-        })
+        }
     }
 
     /// Whether each axis is periodic.
@@ -168,7 +174,7 @@ impl<const D: usize> CellList<D> {
     /// The block along axis d of cell `k` along it (`blocks`).
     #[inline]
     fn block_of_cell(&self, d: usize, k: usize) -> usize {
-        (k / subdivision(d)).min(self.blocks()[d] - 1)
+        (k / subdivision(d)).min(self.blocks_along(d) - 1)
     }
 
     /// The block (linear index, x fastest, in a grid of `blocks()`) of particle k of the sorted
@@ -201,7 +207,7 @@ impl<const D: usize> CellList<D> {
         let cell = ((x - F64s::splat(self.origin[d])) * F64s::splat(self.inv_width[d])).floor();
         let cell = cell.fast_min(F64s::splat((self.dims[d] - 1) as f64));
         let block = (cell * F64s::splat(1.0 / subdivision(d) as f64)).floor();
-        block.fast_min(F64s::splat((self.blocks()[d] - 1) as f64))
+        block.fast_min(F64s::splat((self.blocks_along(d) - 1) as f64))
     }
 
     /// The per-particle array of the grid: the cell of each particle in the sorted order.
