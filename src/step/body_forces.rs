@@ -66,7 +66,7 @@ impl<const D: usize> BodyForces<D> {
         for a in &mut self.force {
             a.resize(nf, 0.0);
         }
-        let frame = self.frame.as_ref().map(|f| f.at(time));
+        let frame = self.frame.as_ref().map(|f| f.over(time, dt));
         let ambient = |i: usize| ambient(frame.as_ref(), set, p, i);
         let targets: Vec<_> = bodies
             .bodies
@@ -141,7 +141,7 @@ impl<const D: usize> BodyForces<D> {
         }
     }
 
-    /// The body forces of the step from `time` on each resting body's particles at their own
+    /// The body forces of the step from `time` to `time + dt` on each resting body's particles at their own
     /// masses m_i, as on a free body's (gravity and its external force, in a moving container
     /// the frame's): Σ m_i f_i and Σ r_ic × m_i f_i, what its supports hold against with the
     /// fluid's force (`Bodies::advance`); zeros for a body that does not rest. Sums over the
@@ -152,13 +152,14 @@ impl<const D: usize> BodyForces<D> {
         bodies: &Bodies,
         set: &StepSettings<D>,
         time: f64,
+        dt: f64,
         nf: usize,
     ) -> Vec<[Vec3; 2]> {
         let mut loads = vec![[[0.0; 3]; 2]; bodies.bodies.len()];
         if bodies.bodies.iter().all(|b| !b.state.resting) {
             return loads;
         }
-        let frame = self.frame.as_ref().map(|f| f.at(time));
+        let frame = self.frame.as_ref().map(|f| f.over(time, dt));
         for i in (0..nf).filter(|&i| p.kind[i] == Kind::Body) {
             let b = p.fluid[i] as usize;
             let body = &bodies.bodies[b];

@@ -365,7 +365,7 @@ impl<const D: usize> Step<D> {
                 eddy
             });
             let loads = match &self.body_forces {
-                Some(stage) => stage.resting_loads(p, bodies, set, time, nf),
+                Some(stage) => stage.resting_loads(p, bodies, set, time, dt, nf),
                 None => Vec::new(),
             };
             if let Some(stage) = &mut self.body_forces {
