@@ -105,7 +105,7 @@ fn the_first_sloshing_mode_keeps_the_period_of_linear_theory() {
     // theory: T1 = 2π/√(g k tanh kh), k = π/L, 1.9171 s. The period is read off the difference of
     // the pressures at the foot of the two end walls, which holds the antisymmetric modes only
     // (the first, and the third at about 1% of its amplitude): twice the mean spacing of its
-    // zero crossings over 2.2–8 s, the signal smoothed over 0.1 s first. Measured: +1.55% (+0.6%
+    // zero crossings over 2.2–8 s, the signal smoothed over 0.1 s first. Measured: +1.55% (+0.7%
     // at 30 particles in the depth: first order in dx; docs/bodies.md, "Sloshing period").
     let (length, depth, spacing) = (0.9, 0.093, 0.0062);
     let k = std::f64::consts::PI / length;
