@@ -4,6 +4,7 @@
 
 use crate::common::{read_frame, run_scene, shipped_scene, tank, TempDir};
 use isph::io::probes;
+use isph::tools::validation::dam_break::slope;
 use isph::Scene;
 
 /// The slope of the free surface in frame `frame`: a line through the top fluid particle of
@@ -23,14 +24,7 @@ fn surface_slope(out: &std::path::Path, frame: usize, spacing: f64, width: f64) 
         .map(|(c, y)| ((*c as f64 + 0.5) * 2.0 * spacing, *y))
         .filter(|(x, _)| *x > 0.05 && *x < width - 0.05)
         .collect();
-    let n = points.len() as f64;
-    let (mx, my) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
-    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
-        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
-    });
-    sxy / sxx
+    slope(&points)
 }
 
 #[test]
@@ -151,8 +145,8 @@ fn the_first_sloshing_mode_keeps_the_period_of_linear_theory() {
 }
 
 /// The mean spacing of the zero crossings after `from` of the signal `f` of the probes.csv
-/// rows (time first), resampled every 5 ms, less its mean and smoothed over 0.1 s: the slope of
-/// a straight line through the crossing times against their count.
+/// rows (time first), resampled every 5 ms, less its mean and smoothed over 0.1 s: the
+/// least-squares slope of the crossing times against their count.
 fn mean_zero_crossing_spacing(rows: &[Vec<f64>], from: f64, f: impl Fn(&[f64]) -> f64) -> f64 {
     let (dt, window) = (0.005, 20);
     let end = rows.last().unwrap()[0];
@@ -181,15 +175,10 @@ fn mean_zero_crossing_spacing(rows: &[Vec<f64>], from: f64, f: impl Fn(&[f64]) -
         .map(|(n, w)| (n as f64 + (mean - w[0]) / (w[1] - w[0])) * dt)
         .collect();
     assert!(crossings.len() >= 4, "{} zero crossings", crossings.len());
-    let count = crossings.len() as f64;
-    let mean_n = (count - 1.0) / 2.0;
-    let mean_t = crossings.iter().sum::<f64>() / count;
-    let (sxy, sxx) = crossings
+    let numbered: Vec<(f64, f64)> = crossings
         .iter()
         .enumerate()
-        .fold((0.0, 0.0), |(a, b), (n, t)| {
-            let dn = n as f64 - mean_n;
-            (a + dn * (t - mean_t), b + dn * dn)
-        });
-    sxy / sxx
+        .map(|(n, &t)| (n as f64, t))
+        .collect();
+    slope(&numbered)
 }

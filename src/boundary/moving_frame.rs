@@ -10,9 +10,9 @@
 //! gravity and the pivot's acceleration turned into the frame, the Euler, centrifugal and
 //! Coriolis forces, each step taking Ẍ and α as their means over it (`MovingFrame::over`). It
 //! is exact, not an approximation of the moving walls: it is Newton's second law written in the
-//! container's frame. A wall particle then needs neither a velocity
-//! nor an acceleration (u_b = a_b = 0 in `ghosts::Motion`), and the Neumann condition of its
-//! ghost pressure carries f: ∂P/∂n = ρ0 f·n (`ghosts::ghost_pressure_difference`).
+//! container's frame. A wall particle then needs neither a velocity nor an acceleration
+//! (u_b = a_b = 0 in `ghosts::Motion`), and the Neumann condition of its ghost pressure carries
+//! f: ∂P/∂n = ρ0 f·n (`ghosts::ghost_pressure_difference`).
 
 use crate::math::rotation::{apply_transposed, cross, Quaternion, Vec3};
 use crate::scene::trajectory::Trajectory;

@@ -141,11 +141,11 @@ impl<const D: usize> BodyForces<D> {
         }
     }
 
-    /// The body forces of the step from `time` to `time + dt` on each resting body's particles at their own
-    /// masses m_i, as on a free body's (gravity and its external force, in a moving container
-    /// the frame's): Σ m_i f_i and Σ r_ic × m_i f_i, what its supports hold against with the
-    /// fluid's force (`Bodies::advance`); zeros for a body that does not rest. Sums over the
-    /// `nf` fluid and body particles in index order.
+    /// The body forces of the step from `time` to `time + dt` on each resting body's particles
+    /// at their own masses m_i, as on a free body's (gravity and its external force, in a moving
+    /// container the frame's): Σ m_i f_i and Σ r_ic × m_i f_i, what its supports hold against
+    /// with the fluid's force (`Bodies::advance`); zeros for a body that does not rest. Sums
+    /// over the `nf` fluid and body particles in index order.
     pub fn resting_loads(
         &self,
         p: &Particles<D>,
