@@ -55,6 +55,10 @@ pub struct Particles<const D: usize> {
     /// How the last pressure solve saw the particle (0 interior or wall, 1 free surface,
     /// 2 splash): written to the frames for inspection, not used by the step.
     pub free_surface: Vec<u8>,
+    /// The thickness across the free surface of a free-surface particle's volume, relative to
+    /// the particle spacing dx: the surface lies half of it beyond the particle's centre
+    /// (`step::surface_thickness`). 1 for every other particle.
+    pub surface_thickness: Vec<f64>,
     /// The index of a fluid particle's fluid in the scene, of a body particle's body; NO_FLUID
     /// for walls.
     pub fluid: Vec<u16>,
@@ -114,6 +118,7 @@ impl<const D: usize> Default for Particles<D> {
             viscosity: Vec::new(),
             kind: Vec::new(),
             free_surface: Vec::new(),
+            surface_thickness: Vec::new(),
             fluid: Vec::new(),
             id: Vec::new(),
         }
@@ -144,6 +149,7 @@ impl<const D: usize> Particles<D> {
         self.viscosity.push(p.viscosity);
         self.kind.push(p.kind);
         self.free_surface.push(0);
+        self.surface_thickness.push(1.0);
         self.fluid.push(p.fluid);
     }
 
@@ -207,6 +213,7 @@ impl<const D: usize> Particles<D> {
             viscosity,
             kind,
             free_surface,
+            surface_thickness,
             fluid,
             id,
         } = self;
@@ -215,7 +222,7 @@ impl<const D: usize> Particles<D> {
             (vel, ["velocity_x", "velocity_y", "velocity_z"]),
             (normal, ["normal_x", "normal_y", "normal_z"]),
         ];
-        let mut arrays = Vec::with_capacity(3 * D + 9);
+        let mut arrays = Vec::with_capacity(3 * D + 10);
         for (v, names) in vectors {
             for (name, component) in names.into_iter().zip(v.iter_mut()) {
                 arrays.push((name, ArrayMut::F64(component)));
@@ -229,6 +236,7 @@ impl<const D: usize> Particles<D> {
             ("viscosity", ArrayMut::F64(viscosity)),
             ("kind", ArrayMut::Kind(kind)),
             ("free_surface", ArrayMut::U8(free_surface)),
+            ("surface_thickness", ArrayMut::F64(surface_thickness)),
             ("fluid", ArrayMut::U16(fluid)),
             ("id", ArrayMut::U64(id)),
         ]);

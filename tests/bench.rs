@@ -29,6 +29,7 @@ const COLUMNS: &[&str] = &[
     "corrector_s",
     "wall_pressure_s",
     "density_correction_s",
+    "surface_thickness_s",
     "shifting_s",
     "advection_s",
     "diagnostics_s",

@@ -313,11 +313,17 @@ max = {size}
     )
 }
 
-/// `run` over three draws of a chaotic run of `scene`: frames every 0.02, 0.025 and 0.03 s land
-/// other steps on them (a step is cut short to land on a frame), and after a plunge or a pile-up
-/// each lands elsewhere. For tests that judge a chaotic outcome over draws, not on one.
-pub fn over_draws<T>(scene: &Scene, run: impl Fn(&Scene) -> T) -> Vec<T> {
-    [0.02, 0.025, 0.03]
+/// Frames every 0.02, 0.025 and 0.03 s: three draws of a chaotic run (`over_draws`).
+pub const THREE_DRAWS: [f64; 3] = [0.02, 0.025, 0.03];
+
+/// Six draws of a chaotic run (`over_draws`), frames every 0.015 to 0.04 s.
+pub const SIX_DRAWS: [f64; 6] = [0.015, 0.02, 0.025, 0.03, 0.035, 0.04];
+
+/// `run` over draws of a chaotic run of `scene`: frames every `intervals` s land other steps on
+/// them (a step is cut short to land on a frame), and after a plunge or a pile-up each lands
+/// elsewhere. For tests that judge a chaotic outcome over draws, not on one.
+pub fn over_draws<T>(scene: &Scene, intervals: &[f64], run: impl Fn(&Scene) -> T) -> Vec<T> {
+    intervals
         .iter()
         .map(|&interval| {
             run(&Scene {

@@ -76,7 +76,7 @@ fn assert_no_penetration(out: &Path) {
 /// found. Without the near-surface pressure reference (`step::corrector::pressure_references`)
 /// it sloshed between 25 and 30 s (docs/stabilisation.md, "The pressure reference near the free
 /// surface"); with the surface rows' pressure taken where the particles start the step, not at
-/// the midpoint of the drift (`ppe::surface_pressure`), a surface wave grew at 0.27/s from the
+/// the midpoint of the drift (`ppe::surface_depth`), a surface wave grew at 0.27/s from the
 /// solver's noise (docs/stabilisation.md, "The surface row at the midpoint of the drift"): the
 /// largest speed over 20–30 s was 180 times the one over 1–10 s at tolerance 1e-6, 1,700 times
 /// at 1e-4. The water's noise is the solver's tolerance's, so the test asks no growth (the

@@ -76,6 +76,13 @@ impl<const D: usize> BodyForce<'_, D> {
         }
     }
 
+    /// The unit vector against f_i, the way up for fluid particle i; None where f_i = 0.
+    pub fn up(&self, i: usize) -> Option<[f64; D]> {
+        let f = self.at(i);
+        let magnitude = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+        (magnitude > 0.0).then(|| f.map(|x| -x / magnitude))
+    }
+
     /// f_j of the fluid particles j in lanes `l`.
     #[inline(always)]
     pub fn lanes(&self, l: &Lanes<D>) -> [F64s; D] {

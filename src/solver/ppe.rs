@@ -6,11 +6,13 @@
 //!   Eq. (6) is their sum. The Laplacian of Eq. (27) is made first-order consistent where the
 //!   free surface truncates the kernel. The wall pairs of the Laplacian are known ghost
 //!   differences and move to the right-hand side (the projection's; P_α's walls are mirrors).
-//! * free-surface rows: P_i = ρ0 |g| δ (`surface_pressure`): P = 0 holds on the surface
-//!   itself, δ beyond the centre of the outermost particle, where the volume that particle
-//!   stands for ends: half a spacing, plus the particle's rise over half a step. (P_i = 0 at
-//!   the particle would put the surface half a spacing too low and the hydrostatic pressure
-//!   ρ g dx/2 short everywhere below.)
+//! * free-surface rows: P_i + δ_i up·∇P_i = 0 (`surface_row_vector`): P = 0 holds on the
+//!   surface itself, δ_i beyond the centre of the outermost particle along the way up, where
+//!   the volume that particle stands for ends: half its thickness across the surface, plus the
+//!   particle's rise over half a step (`surface_depth`); in still water P_i = ρ0 |g| δ_i. (P_i
+//!   = 0 at the particle would put the surface half a spacing too low and the hydrostatic
+//!   pressure ρ g dx/2 short everywhere below.) The row couples the particle to its fluid
+//!   neighbours through the corrected gradient; the walls' ghosts are its right-hand side.
 //! * splash rows (particles too isolated for a gradient): P_i = 0.
 //!
 //! The walls have no row: their pressures for output are computed after the solve from their
@@ -36,8 +38,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub enum Role {
     /// Fluid with a full neighbourhood: the Laplacian row.
     Interior,
-    /// Fluid on the free surface: P = ρ0 |g| δ, the water above its centre, δ about dx/2
-    /// (`surface_pressure`).
+    /// Fluid on the free surface: P + δ up·∇P = 0, the surface δ above its centre, δ about
+    /// dx/2 (`surface_row_vector`); in still water P = ρ0 |g| δ.
     Surface,
     /// Fluid too isolated to have a pressure gradient (spray, drops): P = 0.
     Splash,
@@ -171,7 +173,8 @@ pub fn full_support<const D: usize>(
 /// The per-row vector of the operator ĉ_i = L'_iᵀ c_i of the consistent Laplacian (see
 /// `LaplacianTruncation`), with L'_i the correction of the pressure gradient
 /// (`sph::Moments::m_neumann`; None, the identity, where the kernel correction is off), for
-/// interior rows; zero for the others, which couple nothing.
+/// interior rows; zero for the others (the free-surface rows take theirs in the pressure
+/// solve, `surface_row_vector`).
 /// Deep inside the fluid c_i measures the disorder of the particles, and the row is corrected
 /// all the same: left uncorrected, those rows let still water go unstable within seconds, and
 /// with the correction the tank stays at rest (docs/stabilisation.md, "The free-surface and
@@ -193,37 +196,32 @@ pub fn row_vector<const D: usize>(
     }
 }
 
-/// Pressure of a free-surface particle i: the surface itself lies δ beyond the particle's
-/// centre, so P = 0 there puts P_i = ρ0 |g| δ, the weight of the water above the centre (exact
-/// in still water; where the true P_i is 0, as in a free-falling jet, it errs by ρ0 |g| δ at
-/// most). δ is taken where the particle is at the midpoint of the step's drift, as the
-/// divergence is (`divergence_source`): half a spacing plus its rise over half a step above the
-/// water it stands on, δ = dx/2 − (Δt/2) g·(uⁿ_i − ūⁿ_i)/|g|, with ūⁿ_i the W-weighted mean
-/// velocity of its fluid neighbours (`rise_over_neighbours`). With δ fixed at dx/2 the pressure
-/// under a surface particle rising out of the water answers where it started the step, half a
-/// step behind where the projection applies it: a surface wave about 7 dx long was pushed on a
-/// little late in every period and grew, 8% a period on `hydrostatic_2d`, until the still tank
-/// sloshed after 40 s; with the rise the tank keeps its lattice's noise (docs/stabilisation.md,
-/// "The surface row at the midpoint of the drift"). The rise is taken relative to the water
-/// beneath, so water moving as a whole (a surge, a jet) carries its pressures unchanged: with
-/// uⁿ_i itself the light discs of `dam_break_solids_2d` stayed on the floor twice as often. δ
-/// stays in [0.1, 0.9] dx at CFL 0.4: Δt|uⁿ_j| ≤ 0.4 dx for every particle (`time_step`, on
-/// the same uⁿ). The rows that follow the surface's orientation, ρ0 δ (−g·n)⁺ with n the
-/// surface normal, and the Robin row P_i + δ n·∇P_i = 0, let the surface layer of
-/// `hydrostatic_2d` oscillate with a growing amplitude (docs/stabilisation.md, "The free-surface
-/// and interior rows of the PPE").
+/// The depth δ_i of free-surface particle i under the surface, along `up` (the unit vector
+/// against the body force), at the midpoint of the step's drift, as the divergence is taken
+/// (`divergence_source`): half its thickness across the surface (`Particles::surface_thickness`,
+/// dx at rest) plus its rise over half a step above the water it stands on,
+/// δ = (dx/2) τ_i + (Δt/2) up·(uⁿ_i − ūⁿ_i), with ūⁿ_i the W-weighted mean velocity of its fluid
+/// neighbours (`rise_over_neighbours`). With the rise left out the pressure under a surface
+/// particle rising out of the water answers where it started the step, half a step behind where
+/// the projection applies it: a surface wave about 7 dx long was pushed on a little late in
+/// every period and grew, 8% a period on `hydrostatic_2d`, until the still tank sloshed after
+/// 40 s; with the rise the tank keeps its lattice's noise (docs/stabilisation.md, "The surface
+/// row at the midpoint of the drift"). The rise is taken relative to the water beneath, so water
+/// moving as a whole (a surge, a jet) carries its pressures unchanged: with uⁿ_i itself the light
+/// discs of `dam_break_solids_2d` stayed on the floor twice as often. δ stays in
+/// [0.05, 0.95] dx at CFL 0.4: τ ∈ [0.5, 1.5] and Δt|uⁿ_j| ≤ 0.4 dx for every particle
+/// (`time_step`, on the same uⁿ).
 /// A body's particle at the free surface is in the air, with its body's own surface half a
-/// spacing beyond it and the air beyond that: its pressure is the air's, 0. The body holds
+/// spacing beyond it and the air beyond that: δ = 0, its pressure is the air's. The body holds
 /// its own weight rigidly, so the water-like weight of a half spacing above it would be a
 /// pressure the body's rows above the waterline pass on to the water beside it: a box held at
 /// its draft then read 8.7% less than its buoyancy at dx = 0.01 m and 4.2% at 0.005 m, and kept
 /// the water at its waterline moving at 0.16 m/s; with 0, +1.7% and +0.7%, 0.075 m/s
 /// (docs/bodies.md, "The coupling").
-/// `g` is |`gravity`|.
-fn surface_pressure<const D: usize>(
+pub fn surface_depth<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
-    (gravity, g): ([f64; D], f64),
+    up: [f64; D],
     spacing: f64,
     dt: f64,
     i: usize,
@@ -232,9 +230,42 @@ fn surface_pressure<const D: usize>(
         Kind::Body => 0.0,
         Kind::Fluid | Kind::Wall => {
             let rise = rise_over_neighbours(nb, p, i);
-            let g_u: f64 = (0..D).map(|d| gravity[d] * rise[d]).sum();
-            p.rest_density[i] * (0.5 * spacing * g - 0.5 * dt * g_u)
+            let up_rise: f64 = (0..D).map(|d| up[d] * rise[d]).sum();
+            0.5 * spacing * p.surface_thickness[i] + 0.5 * dt * up_rise
         }
+    }
+}
+
+/// The vector v_i = δ_i L'_iᵀ up_i of free-surface row i, P_i + δ_i up_i·∇P_i = 0, with ∇P_i
+/// the corrected pressure gradient L'_i Σ_j V_j (P_j − P_i) ∇W_ij of the corrector and δ_i
+/// its depth under the surface along up_i, the unit vector against the body force
+/// (`surface_depth`): P = 0 on the surface, extrapolated to the particle. The row is Σ_j V_j
+/// (v_i·∇W_ij)(P_j − P_i) + P_i, and the walls' known ghost differences its right-hand side.
+///
+/// In still water −up·∇P = ρ0 |g| and the row gives P_i = ρ0 |g| δ_i, the weight of the water
+/// above the particle's centre. In a wave it also carries the pressure's dynamic part between
+/// the particle and the surface, which the weight alone leaves out: with P_i = ρ0 |g| δ_i (and
+/// the thickness τ ≡ 1) the first sloshing mode of a tank read 1.5% long at 15 particles in
+/// shallow water, the period of water half a spacing shallower; with the weight of a thickness
+/// that follows the strain but no dynamic part, 0.6% short in deep water; with this row, both
+/// within 0.1% (docs/bodies.md, "Sloshing period"). The row follows the body force's direction,
+/// not the detected surface normal: with the normal, the surface particles beside a side wall
+/// (whose normals the dry wall above them tilts) pushed still water into motion at 7e-3 m/s
+/// within a second and it sloshed at 0.3 m/s by 40 s. Along the body force the two agree to
+/// second order in the surface's slope, and on a steep face of water the row gives what the
+/// weight did.
+/// `up` None (no body force) or `l` None (no corrected gradient: the kernel correction off)
+/// give a zero vector, and the row is P_i = ρ0 |g| δ_i (`projection_source`).
+pub fn surface_row_vector<const D: usize>(
+    l: &Correction<D>,
+    up: Option<[f64; D]>,
+    depth: f64,
+) -> [f64; D] {
+    match (l, up) {
+        (Some(l), Some(up)) => {
+            std::array::from_fn(|a| depth * (0..D).map(|b| l[b][a] * up[b]).sum::<f64>())
+        }
+        _ => [0.0; D],
     }
 }
 
@@ -283,7 +314,11 @@ pub fn projection_source<const D: usize>(
     b.resize(op.roles.len(), 0.0);
     fill(b, |i| match op.roles[i] {
         Role::Interior => divergence_source(nb, p, corrections.of(i), u_star, dt, i),
-        Role::Surface => surface_pressure(nb, p, (op.gravity, g), spacing, dt, i),
+        Role::Surface if op.row_vectors[i] != [0.0; D] => op.surface_wall_source(i),
+        Role::Surface => {
+            let up = op.gravity.map(|x| if g > 0.0 { -x / g } else { 0.0 });
+            p.rest_density[i] * g * surface_depth(nb, p, up, spacing, dt, i)
+        }
         Role::Splash | Role::Reference => 0.0,
     });
     balance_compression(op.roles, closed, sealed, b);
@@ -614,8 +649,43 @@ impl<const D: usize> PressureOperator<'_, D> {
                 });
                 ax.map(|a| a.total())
             }
-            Role::Surface | Role::Splash | Role::Reference => x.map(|x| x[i]),
+            Role::Surface => {
+                let xi = x.map(|x| F64s::splat(x[i]));
+                let mut ax = [Sum::ZERO; K];
+                self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+                    let w = self.surface_weights(i, l, l.load(self.fluid_volume));
+                    for k in 0..K {
+                        ax[k] = ax[k].mul_add(w, l.load(x[k]) - xi[k]);
+                    }
+                });
+                std::array::from_fn(|k| x[k][i] + ax[k].total())
+            }
+            Role::Splash | Role::Reference => x.map(|x| x[i]),
         }
+    }
+
+    /// The weights V_j v_i·∇W_ij of the free-surface row i (`surface_row_vector`) for the lanes
+    /// `l`, with `volume` their V_j.
+    #[inline(always)]
+    fn surface_weights(&self, i: usize, l: &Lanes<D>, volume: F64s) -> F64s {
+        let v = self.row_vectors[i];
+        let radial = self.nb.radial_terms_lanes(l.r);
+        // ∇W_ij = k (r² + η²) r_ij (`RadialTerms`).
+        let v_r = (0..D).fold(F64s::ZERO, |s, d| F64s::splat(v[d]).mul_add(l.rij[d], s));
+        (volume * radial.k * radial.r2_eta2 * v_r) & l.mask
+    }
+
+    /// The right-hand side of free-surface row i: the walls' known ghost differences,
+    /// −Σ_b V_b (v_i·∇W_ib)(P_b − P_i).
+    fn surface_wall_source(&self, i: usize) -> f64 {
+        let p = self.p;
+        let mut b = Sum::ZERO;
+        self.nb.for_each_lanes_of(i, &[Kind::Wall], |l| {
+            let volume = l.load(&p.mass) / l.load(&p.rest_density);
+            let w = self.surface_weights(i, l, volume);
+            b += w * ghost_pressure_difference(p, self.ghost_force.at(i), i, l);
+        });
+        -b.total()
     }
 }
 
@@ -643,7 +713,14 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
                     .for_each_lanes_of(i, &[Kind::Fluid], |l| d += self.fluid_weights(&row, l));
                 interior_diagonal(d)
             }
-            Role::Surface | Role::Splash | Role::Reference => 1.0,
+            Role::Surface => {
+                let mut d = Sum::ZERO;
+                self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+                    d += self.surface_weights(i, l, l.load(self.fluid_volume))
+                });
+                1.0 - d.total()
+            }
+            Role::Splash | Role::Reference => 1.0,
         })
     }
 }

@@ -174,22 +174,35 @@ impl<const D: usize> FreeSurface<D> {
         self.row_vectors[i] = [0.0; D];
     }
 
+    /// Sets the row vector of every free-surface row to `row(i, L'_i)` (`ppe::surface_row_vector`;
+    /// L'_i None without the kernel correction).
+    pub fn set_surface_rows(&mut self, row: impl Fn(usize, &Correction<D>) -> [f64; D] + Sync) {
+        let corrections = stored_corrections(&self.pressure_corrections);
+        let roles = &self.roles;
+        self.row_vectors
+            .par_iter_mut()
+            .enumerate()
+            .filter(|(i, _)| roles[*i] == Role::Surface)
+            .for_each(|(i, v)| *v = row(i, corrections.of(i)));
+    }
+
     pub fn output(&self) -> Surface<'_, D> {
         Surface {
             roles: &self.roles,
             reference: self.reference,
             full_support: &self.full_support,
-            pressure_corrections: self.pressure_corrections(),
+            pressure_corrections: stored_corrections(&self.pressure_corrections),
             normals: self.surface_normal.as_deref(),
             row_vectors: &self.row_vectors,
         }
     }
+}
 
-    fn pressure_corrections(&self) -> Corrections<'_, D> {
-        match &self.pressure_corrections {
-            Some(l) => Corrections::new(true, l),
-            None => Corrections::new(false, &[]),
-        }
+/// The stored L'_i as `Corrections` (the identity without the kernel correction).
+fn stored_corrections<const D: usize>(l: &Option<Vec<Correction<D>>>) -> Corrections<'_, D> {
+    match l {
+        Some(l) => Corrections::new(true, l),
+        None => Corrections::new(false, &[]),
     }
 }
 
@@ -280,7 +293,7 @@ impl<const D: usize> Stage<D> for FreeSurface<D> {
     }
 
     fn describe(&self, _: &StepSettings<D>) -> String {
-        let mut what = "summation density ρ_i = ρ0_i Σ_j V_j W_ij (walls keep ρ0) and the distance to the nearest neighbour (the disorder in stats.csv); moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = ρ0|g|dx/2), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".to_string();
+        let mut what = "summation density ρ_i = ρ0_i Σ_j V_j W_ij (walls keep ρ0) and the distance to the nearest neighbour (the disorder in stats.csv); moment matrix M_i of each kernel support; its smallest eigenvalue and the scan region (Marrone et al. 2010) find the free surface; PPE roles: interior, free surface (P = 0 half its thickness above it), splash (P = 0: the moment matrix of its pressure gradient is near-singular)".to_string();
         if self.pressure_corrections.is_some() {
             what += "; L'_i of Eq. (25) for the pressure gradient and the PPE rows (wall ghosts carry the normal gradient only), inverted from the same moments";
         }

@@ -42,6 +42,7 @@ mod predictor;
 mod pressure_solve;
 mod rigid_bodies;
 mod shifting;
+mod surface_thickness;
 pub mod time_step;
 pub mod timings;
 mod wall_pressure;
@@ -191,6 +192,7 @@ pub struct Step<const D: usize> {
     rigid_bodies: Option<rigid_bodies::RigidBodies>,
     density_correction: Option<density_correction::DensityCorrection<D>>,
     wall_pressure: wall_pressure::WallPressure,
+    surface_thickness: Option<surface_thickness::SurfaceThickness>,
     shifting: Option<shifting::Shifting<D>>,
     advection: advection::Advection,
     diagnostics: diagnostics::Diagnostics,
@@ -232,6 +234,8 @@ impl<const D: usize> Step<D> {
             density_correction: (settings.alpha > 0.0)
                 .then(density_correction::DensityCorrection::default),
             wall_pressure: wall_pressure::WallPressure,
+            surface_thickness: (!settings.confined)
+                .then(surface_thickness::SurfaceThickness::default),
             shifting: effects.shifting.map(shifting::Shifting::new),
             advection: advection::Advection,
             diagnostics: diagnostics::Diagnostics,
@@ -273,6 +277,9 @@ impl<const D: usize> Step<D> {
         }
         stages.push(&self.wall_pressure);
         if let Some(s) = &self.density_correction {
+            stages.push(s);
+        }
+        if let Some(s) = &self.surface_thickness {
             stages.push(s);
         }
         if let Some(s) = &self.shifting {
@@ -405,6 +412,7 @@ impl<const D: usize> Step<D> {
                     corrections,
                     interfaces,
                     ghost,
+                    set.body_force(force),
                     u_star,
                     length,
                     probe,
@@ -466,6 +474,12 @@ impl<const D: usize> Step<D> {
                 }
                 None => None,
             };
+            if let Some(stage) = &mut self.surface_thickness {
+                let thickness = stage.run(&nb, p, &surface, set.body_force(force), dt, nf);
+                // Into the particles: τ for the next step's surface rows.
+                p.surface_thickness[..nf].copy_from_slice(thickness);
+                laps.lap(surface_thickness::NAME);
+            }
             let shift = match &mut self.shifting {
                 Some(stage) => {
                     let velocity = self.corrector.velocity_scratch();

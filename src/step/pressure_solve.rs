@@ -11,6 +11,7 @@
 use super::free_surface::{FreeSurface, Surface};
 use super::time_step::StepLength;
 use super::{Stage, StepSettings};
+use crate::boundary::ghosts::BodyForce;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::{self, fill};
 use crate::neighbours::Neighbours;
@@ -110,6 +111,7 @@ impl<const D: usize> PressureSolve<D> {
         corrections: Corrections<D>,
         interfaces: Option<interface::Field<D>>,
         ghost: Option<&[Vec<f64>; D]>,
+        force: BodyForce<D>,
         u_star: &[Vec<f64>; D],
         step: StepLength,
         probe: Option<&mut dyn FnMut(&PressureOperator<D>)>,
@@ -124,6 +126,15 @@ impl<const D: usize> PressureSolve<D> {
             multigrid,
         } = self;
         pressure.resize(nf, 0.0);
+        let (spacing, dt) = (set.spacing, step.dt);
+        surface.set_surface_rows(|i, l| match l {
+            Some(_) => {
+                let up = force.up(i);
+                let depth = up.map_or(0.0, |up| ppe::surface_depth(nb, p, up, spacing, dt, i));
+                ppe::surface_row_vector(l, up, depth)
+            }
+            None => [0.0; D],
+        });
         with_operator(
             fluid_volume,
             multigrid,
@@ -263,7 +274,7 @@ impl<const D: usize> Stage<D> for PressureSolve<D> {
             String::new()
         };
         format!(
-            "Eq. (6): the projection's source −(ρ0/Δt)(∇·u* − (Δt/2)∂_a u_b ∂_b u_a){}, the divergence at the midpoint of the drift; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P = ρ0|g|dx/2, the water above the particle's centre; BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start{density}",
+            "Eq. (6): the projection's source −(ρ0/Δt)(∇·u* − (Δt/2)∂_a u_b ∂_b u_a){}, the divergence at the midpoint of the drift; Eq. (27) Laplacian made first-order consistent near walls and the free surface, matrix-free; walls: {} (no unknowns); free surface: P + δ e·∇P = 0, the surface δ beyond the particle's centre along the way up e (half its thickness, which follows the strain, plus its rise over half a step; in still water P = ρ0|g|δ); BiCGSTAB preconditioned by additive two-level aggregation multigrid (Jacobi + a coarse V-cycle over the cell blocks), warm start{density}",
             if set.effects.kernel_correction { " (corrected by L_i)" } else { "" },
             match set.ghost_pressure {
                 GhostPressure::Hydrostatic => "Neumann ghosts of the fluid pressure, P_b = P_i + ρ0 g·N_b r_bi",
