@@ -252,8 +252,9 @@ pub fn surface_depth<const D: usize>(
 /// not the detected surface normal: with the normal, the surface particles beside a side wall
 /// (whose normals the dry wall above them tilts) pushed still water into motion at 7e-3 m/s
 /// within a second and it sloshed at 0.3 m/s by 40 s. Along the body force the two agree to
-/// second order in the surface's slope, and on a steep face of water the row gives what the
-/// weight did.
+/// second order in the surface's slope. On a steep face of water (a run-up film, a jet) the row
+/// gives δ_i (−up·∇P_i), near zero where the water falls freely, where the weight gave
+/// ρ0 |g| δ_i.
 /// `up` None (no body force) or `l` None (no corrected gradient: the kernel correction off)
 /// give a zero vector, and the row is P_i = ρ0 |g| δ_i (`projection_source`).
 pub fn surface_row_vector<const D: usize>(
