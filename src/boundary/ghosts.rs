@@ -26,7 +26,7 @@
 //! increment (see `ppe::source`).
 
 use crate::math::lanes::{F64s, Sum};
-use crate::math::vector::dot;
+use crate::math::vector::{dot, norm};
 use crate::neighbours::Lanes;
 use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
@@ -79,7 +79,7 @@ impl<const D: usize> BodyForce<'_, D> {
     /// The unit vector against f_i, the way up for fluid particle i; None where f_i = 0.
     pub fn up(&self, i: usize) -> Option<[f64; D]> {
         let f = self.at(i);
-        let magnitude = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let magnitude = norm(f);
         (magnitude > 0.0).then(|| f.map(|x| -x / magnitude))
     }
 

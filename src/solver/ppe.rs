@@ -255,19 +255,10 @@ pub fn surface_depth<const D: usize>(
 /// second order in the surface's slope. On a steep face of water (a run-up film, a jet) the row
 /// gives δ_i (−up·∇P_i), near zero where the water falls freely, where the weight gave
 /// ρ0 |g| δ_i.
-/// `up` None (no body force) or `l` None (no corrected gradient: the kernel correction off)
-/// give a zero vector, and the row is P_i = ρ0 |g| δ_i (`projection_source`).
-pub fn surface_row_vector<const D: usize>(
-    l: &Correction<D>,
-    up: Option<[f64; D]>,
-    depth: f64,
-) -> [f64; D] {
-    match (l, up) {
-        (Some(l), Some(up)) => {
-            std::array::from_fn(|a| depth * (0..D).map(|b| l[b][a] * up[b]).sum::<f64>())
-        }
-        _ => [0.0; D],
-    }
+/// Without a body force or without a corrected gradient (the kernel correction off) a row
+/// keeps a zero vector and is P_i = ρ0 |g| δ_i (`projection_source`).
+pub fn surface_row_vector<const D: usize>(l: &[[f64; D]; D], up: [f64; D], depth: f64) -> [f64; D] {
+    std::array::from_fn(|a| depth * (0..D).map(|b| l[b][a] * up[b]).sum::<f64>())
 }
 
 /// uⁿ_i − ūⁿ_i, particle i's velocity relative to the W-weighted mean ūⁿ_i of its fluid

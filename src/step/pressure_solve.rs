@@ -127,13 +127,11 @@ impl<const D: usize> PressureSolve<D> {
         } = self;
         pressure.resize(nf, 0.0);
         let (spacing, dt) = (set.spacing, step.dt);
-        surface.set_surface_rows(|i, l| match l {
-            Some(_) => {
-                let up = force.up(i);
-                let depth = up.map_or(0.0, |up| ppe::surface_depth(nb, p, up, spacing, dt, i));
-                ppe::surface_row_vector(l, up, depth)
+        surface.set_surface_rows(|i, l| match (l, force.up(i)) {
+            (Some(l), Some(up)) => {
+                ppe::surface_row_vector(l, up, ppe::surface_depth(nb, p, up, spacing, dt, i))
             }
-            None => [0.0; D],
+            _ => [0.0; D],
         });
         with_operator(
             fluid_volume,

@@ -24,14 +24,13 @@
 
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
-use crate::boundary::ghosts::{ghost_velocity, BodyForce};
-use crate::math::lanes::F64s;
+use crate::boundary::ghosts::BodyForce;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill;
 use crate::neighbours::{Lanes, Neighbours};
-use crate::particles::{Kind, Particles};
+use crate::particles::Particles;
 use crate::solver::ppe::Role;
-use crate::sph::velocity_gradient;
+use crate::sph::{fluid_velocity, velocity_gradient};
 
 pub const NAME: &str = "surface thickness";
 
@@ -85,12 +84,7 @@ fn strain_rate_along<const D: usize>(
     i: usize,
 ) -> f64 {
     let u_i = p.velocity(i);
-    let velocity = |l: &Lanes<D>| -> [F64s; D] {
-        match l.kind {
-            Kind::Wall => ghost_velocity(p, l, u_i, u_i),
-            Kind::Fluid | Kind::Body => std::array::from_fn(|d| l.load(&p.vel[d])),
-        }
-    };
+    let velocity = |l: &Lanes<D>| fluid_velocity(p, u_i, l);
     // G[b][a] = ∂u_a/∂x_b.
     let g = velocity_gradient(nb, p, surface.pressure_corrections.of(i), u_i, velocity, i);
     (0..D)
