@@ -128,7 +128,8 @@ fn first_mode_period_error(depth: f64, tilt: f64) -> f64 {
     let (length, spacing) = (0.9, 0.0062);
     let k = std::f64::consts::PI / length;
     let period = 2.0 * std::f64::consts::PI / (9.81 * k * (k * depth).tanh()).sqrt();
-    let dir = TempDir::new("moving-sloshing-period");
+    // One directory per depth: the two tests run at once in one process.
+    let dir = TempDir::new(&format!("moving-sloshing-period-{depth}"));
     let mut table = String::from("time,x,y,angle\n");
     for step in 0..=1000 {
         let t = step as f64 * 0.01;
