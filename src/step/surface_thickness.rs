@@ -17,6 +17,9 @@
 //! thickness fixed the tank's first sloshing mode had the period of water half a spacing
 //! shallower, 1.5% long at 15 particles in the depth (docs/bodies.md, "Sloshing period").
 //!
+//! A body's particles keep τ = 1: their surface rows sit on the body's own surface
+//! (`ppe::surface_depth`, δ = 0).
+//!
 //! A particle that joins the surface starts at τ = 1 (the water it comes from is at rest on
 //! average), one that leaves it returns to 1. τ is kept within [`MIN_THICKNESS`,
 //! `MAX_THICKNESS`]: on a surface stretched or squeezed for long the shifting refills and
@@ -28,7 +31,7 @@ use crate::boundary::ghosts::BodyForce;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill;
 use crate::neighbours::{Lanes, Neighbours};
-use crate::particles::Particles;
+use crate::particles::{Kind, Particles};
 use crate::solver::ppe::Role;
 use crate::sph::{fluid_velocity, velocity_gradient};
 
@@ -60,8 +63,8 @@ impl SurfaceThickness {
     ) -> &[f64] {
         self.thickness.resize(nf, 1.0);
         fill(&mut self.thickness, |i| {
-            match (surface.roles[i], force.up(i)) {
-                (Role::Surface, Some(up)) => {
+            match (surface.roles[i], force.up(i), p.kind[i]) {
+                (Role::Surface, Some(up), Kind::Fluid) => {
                     let strain = strain_rate_along(nb, p, surface, up, i);
                     (p.surface_thickness[i] * (dt * strain).exp())
                         .clamp(MIN_THICKNESS, MAX_THICKNESS)
