@@ -389,8 +389,16 @@ impl<'a> Run<'a> {
     /// the tolerances used (1e-6 of ‖b‖ and looser), so that a converged solve spends no
     /// apply of A on the report. Otherwise another iteration, or at the iteration limit the
     /// true residual.
+    ///
+    /// A start that already meets the tolerance still takes one iteration (unless it is
+    /// exact). Warm-started from the last step's pressure, a solve that stopped at once would
+    /// leave that pressure's error standing step after step: in water at rest the error the
+    /// tolerance allows is the same in every step, a steady force that lifted the whole water
+    /// off the floor at a constant speed (docs/performance.md, "The PPE tolerance"). One
+    /// iteration a step shrinks it step after step instead.
     fn after_residual(&mut self, r_norm: f64) {
-        if r_norm <= self.tol {
+        let first = self.iterations == 0 && r_norm > 0.0;
+        if r_norm <= self.tol && !first {
             self.finish(Ok(SolveInfo {
                 iterations: self.iterations,
                 relative_residual: r_norm / self.b_norm,
