@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Writes scenes/spheric10_roll.csv, the roll of the SPHERIC benchmark 10 tank (docs/bodies.md,
-"SPHERIC benchmark 10") as a `table` trajectory: time [s], x, y [m] (zero), angle [deg].
+"SPHERIC benchmark 10") as a `table` trajectory: time [s], x, y [m] (zero), angle [deg]; with
+--3d, scenes/spheric10_roll_3d.csv, the same roll with a z column (zero) for the 3D tank.
 
-    tools/spheric10_roll.py [-o FILE]
+    tools/spheric10_roll.py [--3d] [-o FILE]
 
 The experiment's tank followed a recorded roll, distributed with DualSPHysics's sloshing
 example as CaseSloshingMotionData.dat (time and degrees every 0.05 ms). Its steady part is the
@@ -67,15 +68,18 @@ def start_coefficients():
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    default = pathlib.Path(__file__).resolve().parent.parent / "scenes" / "spheric10_roll.csv"
-    parser.add_argument("-o", "--output", type=pathlib.Path, default=default)
-    out = parser.parse_args().output
+    parser.add_argument("--3d", dest="three", action="store_true", help="with a z column")
+    parser.add_argument("-o", "--output", type=pathlib.Path)
+    args = parser.parse_args()
+    name = "spheric10_roll_3d.csv" if args.three else "spheric10_roll.csv"
+    out = args.output or pathlib.Path(__file__).resolve().parent.parent / "scenes" / name
+    offsets = "0,0,0" if args.three else "0,0"
     a = start_coefficients()
-    rows = ["time,x,y,angle"]
+    rows = ["time,x,y,z,angle" if args.three else "time,x,y,angle"]
     for step in range(0, 1601):
         t = 0.005 * step
         theta = sum(c * t**k for c, k in zip(a, POWERS)) if t < JOIN else sinusoid(t)
-        rows.append(f"{t:.3f},0,0,{theta:.6f}")
+        rows.append(f"{t:.3f},{offsets},{theta:.6f}")
     out.write_text("\n".join(rows) + "\n")
 
 
