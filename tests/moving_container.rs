@@ -83,14 +83,14 @@ fn the_spheric_10_tank_hits_its_wall_near_the_experiments_onsets() {
 
 #[test]
 fn the_3d_spheric_10_tank_hits_its_wall_near_the_experiments_first_onset() {
-    // The shipped 3D tank (the 2D scene across the experiment's 62 mm) at twice its spacing,
-    // 12.4 mm (5 particles across, 2,555 fluid particles), to its first impact: the benchmark's
-    // 0.03 s. Measured (the first sample above 1 kPa): 2.3985 s, 0.023 s late. At the shipped
-    // 6.2 mm three trajectories read 0.008–0.016 s early (docs/bodies.md, "SPHERIC benchmark
-    // 10").
+    // The shipped 3D tank (the 2D scene across the experiment's 62 mm) at 15.5 mm, which fits
+    // the depth (6 particles) and the thickness (4) exactly (1,392 fluid particles), to its
+    // first impact: the benchmark's 0.03 s. Measured (the first sample above 1 kPa): 2.3581 s,
+    // 0.017 s early. At the shipped 6.2 mm three trajectories read 0.008–0.016 s early
+    // (docs/bodies.md, "SPHERIC benchmark 10").
     let dir = TempDir::new("moving-spheric10-3d");
     let mut scene = shipped_scene("sloshing_spheric10_3d.toml");
-    scene.spacing = 0.0124;
+    scene.spacing = 0.0155;
     run_scene(&scene, dir.path(), 2.6);
     let onsets = impact_onsets(dir.path());
     assert_eq!(onsets.len(), 1, "impact onsets {onsets:?}");

@@ -81,12 +81,12 @@ fn assert_no_penetration(out: &Path) {
 /// largest speed over 20–30 s was 180 times the one over 1–10 s at tolerance 1e-6, 1,700 times
 /// at 1e-4. A third was the solver's stop: a solve whose warm start already met the tolerance
 /// stopped at once, and the last pressure's error, the same in every step, lifted the whole
-/// water off the floor at a steady 4.4e-6 m/s (at tolerance 1e-4 its mean height rose 4.7e-4
+/// water off the floor at a steady 4.4e-6 m/s (at tolerance 1e-4 its mean height rose by 4.7e-4 of itself
 /// over 5–30 s and about 1e-3 by 60 s, where it stayed; the largest speed 9.9e-5 m/s over
 /// 1–10 s and 1.25e-4 over 20–30 s). Every solve now takes an iteration (`krylov`,
 /// `Run::after_residual`). The test asks no growth (the largest speed over 20–30 s at most
 /// twice the one over 1–10 s), 1e-4 √(gH) = 2.2e-4 m/s throughout and 1e-5 √(gH) from 1 s on,
-/// and the mean height within 2e-5 over 5–30 s. Measured at the default tolerance 1e-4: 2.0e-5
+/// and the mean height within 2e-5 of itself over 5–30 s. Measured at the default tolerance 1e-4: 2.0e-5
 /// m/s in the first second, 2.6e-6 m/s over 1–10 s and over 20–30 s, the mean height 5.6e-7
 /// higher; the pressure at 30 s, the bottom's and the rms error below the surface layer both
 /// 5.1e-5 of ρgH (2.2e-4 before), bounded at 2e-3 (2026-12-06).

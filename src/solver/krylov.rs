@@ -391,14 +391,18 @@ impl<'a> Run<'a> {
     /// true residual.
     ///
     /// A start that already meets the tolerance still takes one iteration, unless it is exact
-    /// to rounding (its residual within ε ‖b‖, or too small to square in f64). Warm-started from the last step's pressure, a solve that stopped at once would
+    /// to rounding (its residual within ε ‖b‖, or too small to square in f64) or the solve
+    /// allows none. (With an iteration limit of 1, that iteration may end above the tolerance,
+    /// as BiCGSTAB's residual need not fall, and the solve then reports itself unconverged.) Warm-started from the last step's pressure, a solve that stopped at once would
     /// leave that pressure's error standing step after step: in water at rest the error the
     /// tolerance allows is the same in every step, a steady force that lifted the whole water
     /// off the floor at a constant speed (docs/performance.md, "The PPE tolerance"). One
     /// iteration a step shrinks it step after step instead.
     fn after_residual(&mut self, r_norm: f64) {
-        let exact = r_norm <= f64::EPSILON * self.b_norm || r_norm * r_norm < f64::MIN_POSITIVE;
-        let first = self.iterations == 0 && !exact;
+        let exact = r_norm <= f64::EPSILON * self.b_norm;
+        let unsquarable = r_norm * r_norm < f64::MIN_POSITIVE;
+        let first =
+            self.iterations == 0 && !exact && !unsquarable && self.params.max_iterations > 0;
         if r_norm <= self.tol && !first {
             self.finish(Ok(SolveInfo {
                 iterations: self.iterations,
