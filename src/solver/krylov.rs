@@ -392,12 +392,13 @@ impl<'a> Run<'a> {
     ///
     /// A start that already meets the tolerance still takes one iteration, unless it is exact
     /// to rounding (its residual within ε ‖b‖, or too small to square in f64) or the solve
-    /// allows none. (With an iteration limit of 1, that iteration may end above the tolerance,
-    /// as BiCGSTAB's residual need not fall, and the solve then reports itself unconverged.) Warm-started from the last step's pressure, a solve that stopped at once would
-    /// leave that pressure's error standing step after step: in water at rest the error the
-    /// tolerance allows is the same in every step, a steady force that lifted the whole water
-    /// off the floor at a constant speed (docs/performance.md, "The PPE tolerance"). One
-    /// iteration a step shrinks it step after step instead.
+    /// allows none. Warm-started from the last step's pressure, a solve that stopped at once
+    /// would leave that pressure's error standing step after step: in water at rest the error
+    /// the tolerance allows is the same in every step, a steady force that lifted the whole
+    /// water off the floor at a constant speed (docs/stabilisation.md, "A solve that stops at
+    /// once"). One iteration a step shrinks it step after step instead. (With an iteration
+    /// limit of 1 that iteration may end above the tolerance, as BiCGSTAB's residual need not
+    /// fall, and the solve then reports itself unconverged.)
     fn after_residual(&mut self, r_norm: f64) {
         let exact = r_norm <= f64::EPSILON * self.b_norm;
         let unsquarable = r_norm * r_norm < f64::MIN_POSITIVE;

@@ -631,29 +631,38 @@ impl<const D: usize> PressureOperator<'_, D> {
         match self.roles[i] {
             Role::Interior => {
                 let row = self.row_constants(i);
-                let xi = x.map(|x| F64s::splat(x[i]));
-                let mut ax = [Sum::ZERO; K];
-                self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-                    let w = self.fluid_weights(&row, l);
-                    for k in 0..K {
-                        ax[k] = ax[k].mul_add(w, xi[k] - l.load(x[k]));
-                    }
-                });
-                ax.map(|a| a.total())
+                self.weighted_differences(x, i, |l| self.fluid_weights(&row, l))
             }
             Role::Surface => {
-                let xi = x.map(|x| F64s::splat(x[i]));
-                let mut ax = [Sum::ZERO; K];
-                self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-                    let w = self.surface_weights(i, l, l.load(self.fluid_volume));
-                    for k in 0..K {
-                        ax[k] = ax[k].mul_add(w, l.load(x[k]) - xi[k]);
-                    }
-                });
-                std::array::from_fn(|k| x[k][i] + ax[k].total())
+                // P_i + Σ_j w_ij (P_j − P_i).
+                let volume = self.fluid_volume;
+                let d =
+                    self.weighted_differences(x, i, |l| self.surface_weights(i, l, l.load(volume)));
+                std::array::from_fn(|k| x[k][i] - d[k])
             }
             Role::Splash | Role::Reference => x.map(|x| x[i]),
         }
+    }
+
+    /// Σ_j w_ij (x_i − x_j) over row i's fluid neighbours for each of the K vectors x, in one
+    /// walk, `weights` giving the w_ij of a lane set. Each vector's sum is the one a walk for it
+    /// alone makes.
+    #[inline(always)]
+    fn weighted_differences<const K: usize>(
+        &self,
+        x: [&[f64]; K],
+        i: usize,
+        weights: impl Fn(&Lanes<D>) -> F64s,
+    ) -> [f64; K] {
+        let xi = x.map(|x| F64s::splat(x[i]));
+        let mut ax = [Sum::ZERO; K];
+        self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+            let w = weights(l);
+            for k in 0..K {
+                ax[k] = ax[k].mul_add(w, xi[k] - l.load(x[k]));
+            }
+        });
+        ax.map(|a| a.total())
     }
 
     /// The weights V_j v_i·∇W_ij of the free-surface row i (`surface_row_vector`) for the lanes
