@@ -73,6 +73,18 @@ pub fn fill<T: Send>(out: &mut [T], f: impl Fn(usize) -> T + Sync) {
         });
 }
 
+/// out[i] ← f(i, out[i]) for every i, in parallel: a per-particle result that replaces the
+/// value it is computed from.
+pub fn update<T: Send + Copy>(out: &mut [T], f: impl Fn(usize, T) -> T + Sync) {
+    out.par_chunks_mut(BLOCK)
+        .enumerate()
+        .for_each(|(c, block)| {
+            for (k, o) in block.iter_mut().enumerate() {
+                *o = f(c * BLOCK + k, *o);
+            }
+        });
+}
+
 /// (a[i], b[i]) = f(i) for every i: two results of one pass.
 pub fn fill_pair<T: Send>(a: &mut [T], b: &mut [T], f: impl Fn(usize) -> [T; 2] + Sync) {
     debug_assert_eq!(a.len(), b.len(), "two results of one pass have one length");

@@ -474,10 +474,18 @@ impl<const D: usize> Step<D> {
                 }
                 None => None,
             };
-            if let Some(stage) = &mut self.surface_thickness {
-                let thickness = stage.run(&nb, p, &surface, set.body_force(force), dt, nf);
-                // Into the particles: τ for the next step's surface rows.
-                p.surface_thickness[..nf].copy_from_slice(thickness);
+            if let Some(stage) = &self.surface_thickness {
+                // τ for the next step's surface rows, updated in the particles' own array.
+                let mut thickness = std::mem::take(&mut p.surface_thickness);
+                stage.run(
+                    &nb,
+                    p,
+                    &surface,
+                    set.body_force(force),
+                    dt,
+                    &mut thickness[..nf],
+                );
+                p.surface_thickness = thickness;
                 laps.lap(surface_thickness::NAME);
             }
             let shift = match &mut self.shifting {

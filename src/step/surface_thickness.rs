@@ -28,8 +28,7 @@
 use super::free_surface::Surface;
 use super::{Stage, StepSettings};
 use crate::boundary::ghosts::BodyForce;
-use crate::math::memory::ArraySize;
-use crate::math::reduce::fill;
+use crate::math::reduce::update;
 use crate::neighbours::{Lanes, Neighbours};
 use crate::particles::{Kind, Particles};
 use crate::solver::ppe::Role;
@@ -42,37 +41,34 @@ pub const NAME: &str = "surface thickness";
 pub const MIN_THICKNESS: f64 = 0.5;
 pub const MAX_THICKNESS: f64 = 1.5;
 
+/// The stage: it holds no array of its own, τ lives with the particles.
 #[derive(Default)]
-pub struct SurfaceThickness {
-    /// τ of each fluid particle after the step.
-    thickness: Vec<f64>,
-}
+pub struct SurfaceThickness;
 
 impl SurfaceThickness {
-    /// τ of the `nf` fluid particles after a step of length `dt`, from their τ before it and
-    /// the drift's velocity uⁿ⁺¹ (the particles' velocity), on the step's free surface, with
-    /// `force` the body force (the way up is against it; none: τ stays 1).
+    /// τ of the fluid particles (`thickness`, the particles' own array, taken out of them for
+    /// the pass) after a step of length `dt`, from their τ before it and the drift's velocity
+    /// uⁿ⁺¹ (the particles' velocity), on the step's free surface, with `force` the body force
+    /// (the way up is against it; none: τ stays 1). τ_i depends on its own old value only, so
+    /// it is updated in place.
     pub fn run<const D: usize>(
-        &mut self,
+        &self,
         nb: &Neighbours<D>,
         p: &Particles<D>,
         surface: &Surface<D>,
         force: BodyForce<D>,
         dt: f64,
-        nf: usize,
-    ) -> &[f64] {
-        self.thickness.resize(nf, 1.0);
-        fill(&mut self.thickness, |i| {
+        thickness: &mut [f64],
+    ) {
+        update(thickness, |i, tau| {
             match (surface.roles[i], force.up(i), p.kind[i]) {
                 (Role::Surface, Some(up), Kind::Fluid) => {
                     let strain = strain_rate_along(nb, p, surface, up, i);
-                    (p.surface_thickness[i] * (dt * strain).exp())
-                        .clamp(MIN_THICKNESS, MAX_THICKNESS)
+                    (tau * (dt * strain).exp()).clamp(MIN_THICKNESS, MAX_THICKNESS)
                 }
                 _ => 1.0,
             }
         });
-        &self.thickness
     }
 }
 
@@ -102,9 +98,5 @@ impl<const D: usize> Stage<D> for SurfaceThickness {
 
     fn describe(&self, _: &StepSettings<D>) -> String {
         format!("each free-surface particle's thickness across the surface, which places the surface beyond it: τ ← τ exp(Δt e·∇uⁿ⁺¹·e), e against the body force, while it stays on the surface, 1 elsewhere, within [{MIN_THICKNESS}, {MAX_THICKNESS}] spacings")
-    }
-
-    fn arrays(&self) -> Vec<ArraySize> {
-        vec![ArraySize::of("surface thickness", &self.thickness)]
     }
 }
