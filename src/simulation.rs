@@ -60,6 +60,9 @@ pub struct Simulation<const D: usize> {
     pub bodies: Bodies,
     pub time: f64,
     pub step: u64,
+    /// Δt of the last step (none before the first): a sliver of a step takes the divergence
+    /// the particles carry into it out over it (`StepLength::carried_time`).
+    pub last_dt: Option<f64>,
     /// The stages of a step and their scratch.
     stepper: Step<D>,
     /// Time spent in each stage so far.
@@ -139,6 +142,7 @@ impl<const D: usize> Simulation<D> {
             bodies,
             time: 0.0,
             step: 0,
+            last_dt: None,
             stepper,
             timings,
             periods: std::array::from_fn(|d| periodic[d].then(|| c.max[d] - c.min[d])),
@@ -199,6 +203,7 @@ impl<const D: usize> Simulation<D> {
             &mut self.bodies,
             self.time,
             target,
+            self.last_dt,
             &mut self.timings,
             probe,
         );
@@ -209,6 +214,7 @@ impl<const D: usize> Simulation<D> {
             self.time + report.length.dt
         };
         self.step += 1;
+        self.last_dt = Some(report.length.dt);
         Ok(StepStats {
             step: self.step,
             time: self.time,

@@ -238,6 +238,16 @@ fn a_continued_2d_run_is_bit_identical_to_one_never_stopped() {
     assert!(summary.steps > 10, "only {} steps after T/2", summary.steps);
     assert_same_run::<2>(&whole, &split, "stopped at T/2");
 
+    // Stopped at T/2 and continued to a sliver past it: the sliver takes the divergence the
+    // particles carry out over the last step's Δt, which the checkpoint holds (`dt`).
+    let sliver = half + 1e-5;
+    let through = dir.path().join("through");
+    run::run(&scene, &run_options(&through, sliver)).unwrap();
+    let resumed = dir.path().join("resumed");
+    run::run(&scene, &run_options(&resumed, half)).unwrap();
+    assert_eq!(resume_until(&resumed, sliver).steps, 1);
+    assert_same_run::<2>(&through, &resumed, "continued to a sliver past T/2");
+
     // Stopped by a signal after its first step (between two frames), continued to T.
     let signalled = dir.path().join("signalled");
     let opts = run_options(&signalled, end);

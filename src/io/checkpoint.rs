@@ -39,7 +39,8 @@ const BODIES: &str = "bodies";
 pub struct RunState {
     pub step: u64,
     pub time: f64,
-    /// Δt of the last step (reported on resume; each step computes its own Δt).
+    /// Δt of the last step (0 before the first): a sliver of a step after it takes the
+    /// divergence the particles carry into it out over it (`StepLength::carried_time`).
     pub dt: f64,
     /// Wall-clock seconds the run had taken; stats.csv continues from there.
     pub wall_seconds: f64,

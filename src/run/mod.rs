@@ -184,6 +184,7 @@ fn resume_in<const D: usize>(
     let start = resume::cut_back(checked)?;
     sim.time = checkpoint.state.time;
     sim.step = checkpoint.state.step;
+    sim.last_dt = (checkpoint.state.dt > 0.0).then_some(checkpoint.state.dt);
     Driver::new(
         &start.scene,
         sim,

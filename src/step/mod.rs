@@ -309,7 +309,8 @@ impl<const D: usize> Step<D> {
     }
 
     /// Sorts the particles by cell, then advances them by one step towards the simulated time
-    /// `target` from `time` (`time_step::length`). The step that lands on the target also
+    /// `target` from `time` (`time_step::length`; `last_dt` the last step's Δt, none on a
+    /// run's first). The step that lands on the target also
     /// computes the wall particles' pressure for the frame: in a large tank most wall
     /// particles are dry, and visiting them at every step costs a large part of a step
     /// (docs/performance.md, "Walls no fluid touches").
@@ -323,6 +324,7 @@ impl<const D: usize> Step<D> {
         bodies: &mut Bodies,
         time: f64,
         target: f64,
+        last_dt: Option<f64>,
         timings: &mut Timings,
         probe: Option<&mut dyn FnMut(&PressureOperator<D>)>,
     ) -> Result<StepReport, StepError> {
@@ -334,7 +336,7 @@ impl<const D: usize> Step<D> {
         }
         laps.lap(cell_list::NAME);
         let (limit, _) = time_step::limiting(p, self.kernel.width(), &self.settings)?;
-        let (length, lands_on_target) = time_step::length(limit, target - time);
+        let (length, lands_on_target) = time_step::length(limit, target - time, last_dt);
         let set = &self.settings;
         let dt = length.dt;
         let fluid = self.grid().range_of(Kind::Fluid);

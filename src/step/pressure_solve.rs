@@ -156,6 +156,7 @@ impl<const D: usize> PressureSolve<D> {
                     corrections,
                     u_star,
                     step.dt,
+                    step.carried_time(),
                     rhs,
                 );
                 let roles = op.roles;

@@ -19,8 +19,28 @@ pub struct StepLength {
     pub dt: f64,
     /// Δt_max, the limit of the CFL, viscous and body-force conditions [s]: Δt is shorter
     /// only where the step is cut to land on a frame time. The density-invariance term of the
-    /// PPE relaxes the density error over Δt_max, not Δt (`ppe::source`).
+    /// PPE relaxes the density error over Δt_max, not Δt (`ppe::density_source`).
     pub limit: f64,
+    /// Δt of the last step [s] (Δt_max on a run's first step).
+    pub previous: f64,
+}
+
+/// A step shorter than this fraction of its limit is a sliver (`StepLength::carried_time`):
+/// the two halves before a frame are never one.
+const SLIVER: f64 = 0.5;
+
+impl StepLength {
+    /// The time over which the projection takes out the divergence the particles carry into
+    /// the step (`ppe::divergence_source`): Δt, but on a sliver of a step (a last step just past
+    /// a frame, a frame just before a body's release) the last step's Δt, which made most of it.
+    /// Over the sliver the step's pressure would read (1 + Δt_prev/Δt)/2 times the flow's.
+    pub fn carried_time(&self) -> f64 {
+        if self.dt < SLIVER * self.limit {
+            self.previous.max(self.dt)
+        } else {
+            self.dt
+        }
+    }
 }
 
 /// Which condition sets Δt_max.
@@ -82,7 +102,8 @@ pub fn limiting<const D: usize>(
 
 /// The step of at most `limit` towards a target `remaining` ahead, and whether it lands on
 /// it: exactly when it is within reach (two steps to go are split evenly, so no step is tiny).
-pub fn length(limit: f64, remaining: f64) -> (StepLength, bool) {
+/// `previous`: the last step's Δt (none on a run's first step).
+pub fn length(limit: f64, remaining: f64, previous: Option<f64>) -> (StepLength, bool) {
     let dt = if remaining <= limit {
         remaining
     } else if remaining < 2.0 * limit {
@@ -90,5 +111,13 @@ pub fn length(limit: f64, remaining: f64) -> (StepLength, bool) {
     } else {
         limit
     };
-    (StepLength { dt, limit }, dt == remaining)
+    let previous = previous.unwrap_or(limit);
+    (
+        StepLength {
+            dt,
+            limit,
+            previous,
+        },
+        dt == remaining,
+    )
 }
