@@ -210,7 +210,6 @@ struct Driver<'a, const D: usize> {
     /// Wall-clock seconds the run had taken before this process continued it.
     wall_before: f64,
     started: Instant,
-    last_dt: f64,
     /// The newest checkpoint on disk.
     last_saved: Option<Saved>,
     /// When this process last wrote a checkpoint (or started).
@@ -260,7 +259,6 @@ impl<'a, const D: usize> Driver<'a, D> {
             next_output: state.map_or(0, |s| s.next_output),
             wall_before: state.map_or(0.0, |s| s.wall_seconds),
             started: now,
-            last_dt: state.map_or(0.0, |s| s.dt),
             last_saved: resumed.map(|c| Saved {
                 path: c.path().to_owned(),
                 step: c.state.step,
@@ -387,7 +385,7 @@ impl<'a, const D: usize> Driver<'a, D> {
         let state = RunState {
             step: self.sim.step,
             time: self.sim.time,
-            dt: self.last_dt,
+            dt: self.sim.last_dt.unwrap_or(0.0),
             wall_seconds: self.wall_seconds(),
             frames_written: self.output.frames.len() as u64,
             next_output: self.next_output,
@@ -453,7 +451,6 @@ impl<'a, const D: usize> Driver<'a, D> {
             };
             steps += 1;
             ppe_total += step.ppe_iterations as u64;
-            self.last_dt = step.dt;
             self.output.stats.row(&step, self.wall_seconds())?;
             if let Some(probes) = &mut self.output.probes {
                 probes.row(self.sim.time, &self.sim.probe_values(&self.scene.probes))?;
