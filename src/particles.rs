@@ -41,7 +41,9 @@ pub const NO_FLUID: u16 = u16::MAX;
 pub struct Particles<const D: usize> {
     pub pos: [Vec<f64>; D],
     pub vel: [Vec<f64>; D],
-    /// Unit normal of the wall at a wall particle, pointing into the fluid (zero for fluid).
+    /// Unit normal of the wall at a wall particle, pointing into the fluid; at a body's
+    /// particle its body's outward surface normal (`bodies::SurfacePoint`), for the no-slip of
+    /// the viscous term; zero for fluid.
     pub normal: [Vec<f64>; D],
     pub pressure: Vec<f64>,
     /// Summation density ρ_i = Σ_j m_j W_ij (fluid); the rest density for walls.

@@ -435,6 +435,30 @@ fn each_bad_body_is_refused_with_its_key() {
 }
 
 #[test]
+fn a_body_that_could_cross_a_period_is_refused() {
+    // A held body stays where the box holds it; a free one, or one let go, could cross the
+    // period, and a body's particles are not wrapped.
+    let dir = TempDir::new("bad-periodic-bodies");
+    let periodic = good().replace(
+        "max = [0.4, 0.3]\n",
+        "max = [0.4, 0.3]\nperiodic = [true, false]\n",
+    );
+    let body = |text: &str| {
+        format!("{periodic}\n[[body]]\nshape = \"circle\"\ncenter = [0.3, 0.15]\nradius = 0.03\ndensity = 500.0\n{text}\n")
+    };
+    for text in ["", "motion = \"fixed\"\nrelease = 0.005"] {
+        let (code, stderr) = run_text(dir.path(), &body(text), &[]);
+        assert_refused(
+            code,
+            &stderr,
+            &["body[0].motion", "periodic container", "held"],
+        );
+    }
+    let (code, stderr) = run_text(dir.path(), &body("motion = \"fixed\""), &[]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+#[test]
 fn each_bad_trajectory_is_refused_with_its_key() {
     let dir = TempDir::new("bad-trajectories");
     std::fs::write(

@@ -128,8 +128,26 @@ pub struct RigidBody {
     pub first_id: u64,
     /// Each particle's offset from the centre of mass in the body's own frame, by id − first_id.
     pub offsets: Vec<Vec3>,
+    /// Each particle's depth below the body's surface and the surface's outward normal there,
+    /// in the body's own frame, by id − first_id (`SurfacePoint`).
+    pub surface: Vec<SurfacePoint>,
     pub state: RigidState,
 }
+
+/// Where a body particle lies under its body's surface: the fluid's no-slip at the body
+/// (`step::body_surfaces`) puts the body's velocity on the surface itself, as at a wall.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// Distance from the particle's centre to the surface [m] (> 0).
+    pub depth: f64,
+    /// The surface's outward unit normal nearest the particle, in the body's own frame; zero
+    /// for a particle deeper than `SURFACE_REACH` spacings, which no fluid reaches.
+    pub normal: Vec3,
+}
+
+/// Depth, in particle spacings, down to which a body particle keeps its surface normal: the
+/// widest kernel support (the quintic at h/dx = 2 reaches 6 spacings).
+const SURFACE_REACH: f64 = 6.0;
 
 /// Where a fixed or prescribed body is taken by the end of a step: its pose and velocities.
 #[derive(Clone, Copy, Debug)]
@@ -217,6 +235,12 @@ impl RigidBody {
         rotation::apply(r, self.offsets[(id - self.first_id) as usize])
     }
 
+    /// The outward surface normal at particle `id` (`SurfacePoint`), in the world frame, for
+    /// rotation `r`.
+    pub fn normal(&self, r: &Mat3, id: u64) -> Vec3 {
+        rotation::apply(r, self.surface[(id - self.first_id) as usize].normal)
+    }
+
     /// Moves the pose over a step of `dt` over which the centre's velocity went from `start` to
     /// the state's: the centre by the trapezoid, exact under a constant force (free fall), and
     /// the orientation by a turn of ωⁿ⁺¹ Δt (Eq. 15–16).
@@ -263,6 +287,9 @@ pub struct Bodies {
     /// The container's faces a body's particles keep half a spacing off, per axis (None along
     /// a periodic axis).
     faces: Vec<Option<(f64, f64)>>,
+    /// The container's length along each periodic axis (None along a bounded one): a fluid
+    /// particle near a body across the period is near its image.
+    periods: Vec<Option<f64>>,
     /// The obstacles, which bodies touch as they touch each other.
     obstacles: Vec<Shape>,
     spacing: f64,
@@ -307,6 +334,10 @@ impl Bodies {
                         std::array::from_fn(|d| x[d] - centre[d])
                     })
                     .collect();
+                let surface: Vec<SurfacePoint> = members
+                    .iter()
+                    .map(|&i| surface_point(&body.shape, at(i), scene.spacing, D))
+                    .collect();
                 let masses: Vec<f64> = members.iter().map(|&i| p.mass[i]).collect();
                 let inertia = inertia_tensor(&offsets, &masses, D);
                 let spin: Vec3 = match body.angular_velocity[..] {
@@ -346,6 +377,7 @@ impl Bodies {
                     friction: body.friction,
                     first_id,
                     offsets,
+                    surface,
                     state: RigidState {
                         centre,
                         orientation: Quaternion::IDENTITY,
@@ -374,6 +406,9 @@ impl Bodies {
             bodies,
             faces: (0..D)
                 .map(|d| (!scene.periodic[d]).then_some((c.min[d], c.max[d])))
+                .collect(),
+            periods: (0..D)
+                .map(|d| scene.periodic[d].then_some(c.max[d] - c.min[d]))
                 .collect(),
             obstacles: scene
                 .obstacles
@@ -438,16 +473,39 @@ impl Bodies {
         self.held_in_solve = Some(held);
     }
 
-    /// Gives the bodies' particles their bodies' rigid velocities (at t = 0).
+    /// Gives the bodies' particles their bodies' rigid velocities and surface normals (at
+    /// t = 0).
     pub fn set_particle_velocities<const D: usize>(&self, p: &mut Particles<D>) {
         for i in (0..p.len()).filter(|&i| p.kind[i] == Kind::Body) {
             let body = &self.bodies[p.fluid[i] as usize];
-            let arm = body.arm(&body.rotation(), p.id[i]);
+            let r = body.rotation();
+            let arm = body.arm(&r, p.id[i]);
             let u = rigid_velocity(body.state.velocity, body.angular_velocity(), arm);
+            let n = body.normal(&r, p.id[i]);
             for d in 0..D {
                 p.vel[d][i] = u[d];
+                p.normal[d][i] = n[d];
             }
         }
+    }
+
+    /// Whether a point at `x` lies within `margin` of some body's bounding sphere (across a
+    /// periodic boundary too).
+    pub fn near<const D: usize>(&self, x: [f64; D], margin: f64) -> bool {
+        self.bodies.iter().any(|b| {
+            let arm = (0..D).map(|d| {
+                let a = x[d] - b.state.centre[d];
+                self.periods[d].map_or(a, |l| a - l * (a / l).round())
+            });
+            arm.map(|a| a * a).sum::<f64>() <= (b.reach + margin).powi(2)
+        })
+    }
+
+    /// The depth below its body's surface of the particle `id` of body `body`
+    /// (`SurfacePoint`).
+    pub fn depth(&self, body: usize, id: u64) -> f64 {
+        let b = &self.bodies[body];
+        b.surface[(id - b.first_id) as usize].depth
     }
 
     /// The states of every body, one after the other (a checkpoint's `bodies` array).
@@ -608,6 +666,18 @@ impl Bodies {
         }
         (moved, crossed)
     }
+}
+
+/// The `SurfacePoint` of a particle at x (where the body starts) of a body of shape `shape`.
+fn surface_point(shape: &Shape, x: Vec3, spacing: f64, dims: usize) -> SurfacePoint {
+    let distance = |y: &Vec3| shape.signed_distance(&y[..dims]);
+    let depth = -distance(&x);
+    let normal = if depth < SURFACE_REACH * spacing {
+        outward_normal(&distance, x, spacing, dims).unwrap_or([0.0; 3])
+    } else {
+        [0.0; 3]
+    };
+    SurfacePoint { depth, normal }
 }
 
 /// I = Σ m (|r|² 1 − r ⊗ r) of point masses `masses` at `offsets` from the centre; in 2D only

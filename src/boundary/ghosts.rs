@@ -157,11 +157,20 @@ pub fn no_slip_difference<const D: usize>(
     d_i: F64s,
 ) -> [F64s; D] {
     let n_r = (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s));
-    let beta = (n_r / d_i)
-        .fast_max(F64s::ONE)
-        .fast_min(F64s::splat(MORRIS_BETA_MAX));
+    let beta = morris_factor(n_r, d_i);
     let u_b = motion(p, l).velocity;
     std::array::from_fn(|d| beta * (F64s::splat(u_i[d]) - u_b[d]))
+}
+
+/// β = 1 + d_b/d_i of the no-slip velocity of Morris, Fox & Zhu (1997) of a boundary particle
+/// b whose outward normal (into the fluid) projected on r_ib is `n_r` = d_b + d_i, seen from a
+/// fluid particle at `d_i` from the boundary's face; at least 1, at most `MORRIS_BETA_MAX`.
+/// The walls' (`no_slip_difference`) and the bodies' (`sph::viscous_acceleration`).
+#[inline(always)]
+pub fn morris_factor(n_r: F64s, d_i: F64s) -> F64s {
+    (n_r / d_i)
+        .fast_max(F64s::ONE)
+        .fast_min(F64s::splat(MORRIS_BETA_MAX))
 }
 
 /// Cap on β of the no-slip wall velocity. Morris, Fox & Zhu take 1.5 against particles right

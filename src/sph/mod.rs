@@ -103,12 +103,15 @@ pub fn viscous_acceleration<const D: usize>(
     p: &Particles<D>,
     eddy: Option<&[f64]>,
     face: Option<Face<D>>,
+    bodies: Option<&[f64]>,
     i: usize,
 ) -> [f64; D] {
     let (rho_i, nu_laminar) = (p.rest_density[i], p.viscosity[i]);
-    let nu_i = nu_laminar + eddy.map_or(0.0, |e| e[i]);
+    let nu_t_i = eddy.map_or(0.0, |e| e[i]);
+    let nu_i = nu_laminar + nu_t_i;
     let d_i = F64s::splat(face.map_or(f64::INFINITY, |f| f.distance));
     let u_i = p.velocity(i);
+    let no_slip = bodies.and_then(|distances| body_no_slip(p, distances, i));
     let mut acc = [Sum::ZERO; D];
     nb.for_each_lanes(i, |l| {
         let (nu_i, nu_j, du): (F64s, F64s, [F64s; D]) = match l.kind {
@@ -119,7 +122,16 @@ pub fn viscous_acceleration<const D: usize>(
             Kind::Fluid | Kind::Body => {
                 let nu_t = eddy.map_or(F64s::ZERO, |e| l.load(e));
                 let du = std::array::from_fn(|d| F64s::splat(u_i[d]) - l.load(&p.vel[d]));
-                (F64s::splat(nu_i), l.load(&p.viscosity) + nu_t, du)
+                match no_slip {
+                    // The laminar viscosity of a pair of a fluid and a body particle takes β,
+                    // the eddy viscosity's part not (as at a wall, whose pairs are laminar).
+                    Some(b) => {
+                        let beta = b.factor(p, l);
+                        let nu_i = F64s::splat(nu_laminar).mul_add(beta, F64s::splat(nu_t_i));
+                        (nu_i, l.load(&p.viscosity).mul_add(beta, nu_t), du)
+                    }
+                    None => (F64s::splat(nu_i), l.load(&p.viscosity) + nu_t, du),
+                }
             }
         };
         let (rho_j, rho_i) = (l.load(&p.rest_density), F64s::splat(rho_i));
@@ -132,6 +144,68 @@ pub fn viscous_acceleration<const D: usize>(
         }
     });
     acc.map(|a| a.total())
+}
+
+/// The no-slip of a body for the viscous term of particle i (`viscous_acceleration`): the
+/// pairs of a fluid particle and a body's particle take the factor β of Morris, Fox & Zhu
+/// (1997) on their velocity difference, as a fluid particle's pairs with a wall's do
+/// (`ghosts::no_slip_difference`), so that the body's velocity holds on its surface, not half a
+/// spacing inside it. Both particles of a pair take the same β, so the viscous forces between
+/// the fluid and a body stay equal and opposite and the body feels what it does to the fluid.
+#[derive(Clone, Copy)]
+enum BodyNoSlip<'a> {
+    /// i is a fluid particle at `distance` from the nearest body's surface: a body particle b
+    /// takes β = n_b·r_ib/distance (its outward normal in `Particles::normal`, zero for a
+    /// fluid particle, whose β is 1).
+    Fluid { distance: f64 },
+    /// i is a body particle with outward normal `normal`: a fluid particle j takes
+    /// β = n_i·r_ji/d_j, d_j from `distances` (infinite for a body particle: β = 1).
+    Body {
+        normal: [f64; 3],
+        distances: &'a [f64],
+    },
+}
+
+/// The `BodyNoSlip` of particle i from the distances of the fluid particles to the nearest
+/// body's surface (`step::body_surfaces`); None where every β is 1.
+fn body_no_slip<'a, const D: usize>(
+    p: &Particles<D>,
+    distances: &'a [f64],
+    i: usize,
+) -> Option<BodyNoSlip<'a>> {
+    match p.kind[i] {
+        Kind::Fluid => distances[i].is_finite().then_some(BodyNoSlip::Fluid {
+            distance: distances[i],
+        }),
+        Kind::Body => {
+            let n = p.wall_normal(i);
+            n.iter().any(|&c| c != 0.0).then(|| BodyNoSlip::Body {
+                normal: std::array::from_fn(|d| if d < D { n[d] } else { 0.0 }),
+                distances,
+            })
+        }
+        Kind::Wall => None,
+    }
+}
+
+impl BodyNoSlip<'_> {
+    /// β of the pairs of particle i with the particles in lanes `l` (of the fluid's group).
+    #[inline(always)]
+    fn factor<const D: usize>(&self, p: &Particles<D>, l: &Lanes<D>) -> F64s {
+        match *self {
+            BodyNoSlip::Fluid { distance } => {
+                let n_r = (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s));
+                ghosts::morris_factor(n_r, F64s::splat(distance))
+            }
+            BodyNoSlip::Body { normal, distances } => {
+                // r_ji = −r_ij.
+                let n_r = (0..D).fold(F64s::ZERO, |s, d| {
+                    F64s::splat(-normal[d]).mul_add(l.rij[d], s)
+                });
+                ghosts::morris_factor(n_r, l.load(distances))
+            }
+        }
+    }
 }
 
 /// The SPH Laplacian of a vector field `f` of the fluid particles at fluid particle i, from its

@@ -29,6 +29,7 @@
 
 mod advection;
 mod body_forces;
+mod body_surfaces;
 mod cell_list;
 mod corrector;
 mod density_correction;
@@ -185,6 +186,7 @@ pub struct Step<const D: usize> {
     kernel_correction: Option<kernel_correction::KernelCorrection<D>>,
     eddy_viscosity: Option<eddy_viscosity::EddyViscosity>,
     body_forces: Option<body_forces::BodyForces<D>>,
+    body_surfaces: Option<body_surfaces::BodySurfaces>,
     predictor: predictor::Predictor<D>,
     hydrostatic_split: Option<hydrostatic_split::HydrostaticSplit<D>>,
     pressure_solve: pressure_solve::PressureSolve<D>,
@@ -226,6 +228,7 @@ impl<const D: usize> Step<D> {
                 .then(kernel_correction::KernelCorrection::default),
             eddy_viscosity: effects.les.map(eddy_viscosity::EddyViscosity::new),
             body_forces: (bodies || frame.is_some()).then(|| body_forces::BodyForces::new(frame)),
+            body_surfaces: bodies.then(body_surfaces::BodySurfaces::default),
             predictor: predictor::Predictor::new(&settings),
             hydrostatic_split: body_interfaces.then(hydrostatic_split::HydrostaticSplit::default),
             pressure_solve: pressure_solve::PressureSolve::new(settings.alpha > 0.0),
@@ -265,6 +268,9 @@ impl<const D: usize> Step<D> {
             stages.push(s);
         }
         if let Some(s) = &self.body_forces {
+            stages.push(s);
+        }
+        if let Some(s) = &self.body_surfaces {
             stages.push(s);
         }
         stages.push(&self.predictor);
@@ -382,6 +388,11 @@ impl<const D: usize> Step<D> {
                 stage.run(&nb, p, bodies, set, &surface, interfaces, time, dt, nf);
                 laps.lap(body_forces::NAME);
             }
+            let body_surfaces = self.body_surfaces.as_mut().map(|stage| {
+                stage.run(&nb, p, bodies, set.spacing, nf);
+                laps.lap(body_surfaces::NAME);
+                stage.distances()
+            });
             let force = self.body_forces.as_ref().map(|stage| stage.force());
             let ghost = self.body_forces.as_ref().map(|stage| stage.ghost());
             let u_star = self.predictor.run(
@@ -390,6 +401,7 @@ impl<const D: usize> Step<D> {
                 set,
                 eddy,
                 set.body_force(force),
+                body_surfaces,
                 full_support,
                 dt,
                 nf,

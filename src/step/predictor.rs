@@ -59,7 +59,9 @@ impl<const D: usize> Predictor<D> {
     }
 
     /// u* of the `nf` fluid particles over `dt`; `eddy` is ν_t with LES, `force` the body
-    /// force, `full_support` whether a fluid particle's support holds no free-surface particle.
+    /// force, `bodies` the distance of each to the nearest body's surface in a scene with
+    /// bodies (`body_surfaces`), `full_support` whether a fluid particle's support holds no
+    /// free-surface particle.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -68,6 +70,7 @@ impl<const D: usize> Predictor<D> {
         set: &StepSettings<D>,
         eddy: Option<&[f64]>,
         force: BodyForce<D>,
+        bodies: Option<&[f64]>,
         full_support: &[bool],
         dt: f64,
         nf: usize,
@@ -78,7 +81,7 @@ impl<const D: usize> Predictor<D> {
         let spacing = set.spacing;
         match &mut self.laminar {
             Some(laminar) => {
-                laminar.run(nb, p, spacing, full_support, nf);
+                laminar.run(nb, p, spacing, bodies, full_support, nf);
                 let (viscous, fluid_support) = (&laminar.viscous, &laminar.fluid_support);
                 let smoothing = nb.kernel.deviation().powi(2) / 4.0;
                 fill_vector(&mut self.u_star, |i| {
@@ -100,7 +103,7 @@ impl<const D: usize> Predictor<D> {
                 fill_vector(&mut self.u_star, |i| {
                     // The nearest wall, for the no-slip wall velocity and the wall function.
                     let face = ghosts::nearest_face(nb, p, spacing, support, i);
-                    let visc = sph::viscous_acceleration(nb, p, eddy, face, i);
+                    let visc = sph::viscous_acceleration(nb, p, eddy, face, bodies, i);
                     let wall = if wall_function {
                         les::wall_shear(p, spacing, face, i)
                     } else {
@@ -122,6 +125,7 @@ impl<const D: usize> Laminar<D> {
         nb: &Neighbours<D>,
         p: &Particles<D>,
         spacing: f64,
+        bodies: Option<&[f64]>,
         full_support: &[bool],
         nf: usize,
     ) {
@@ -142,7 +146,7 @@ impl<const D: usize> Laminar<D> {
                 && !(mixed && touches_another_material(nb, p, i));
             (
                 fluid_support,
-                sph::viscous_acceleration(nb, p, None, face, i),
+                sph::viscous_acceleration(nb, p, None, face, bodies, i),
             )
         });
     }

@@ -106,9 +106,9 @@ impl RigidBodies {
         }
     }
 
-    /// Puts the body particles where their bodies' poses put them, then the `nf` fluid
-    /// particles that came within a quarter spacing of a body back off it (`Bodies::keep_out`);
-    /// returns how many had crossed a body's surface.
+    /// Puts the body particles where their bodies' poses put them, with their surface normals
+    /// turned with them, then the `nf` fluid particles that came within a quarter spacing of a
+    /// body back off it (`Bodies::keep_out`); returns how many had crossed a body's surface.
     pub fn place<const D: usize>(
         &self,
         p: &mut Particles<D>,
@@ -122,8 +122,10 @@ impl RigidBodies {
             let b = p.fluid[i] as usize;
             let body = &bodies.bodies[b];
             let arm = body.arm(&rotations[b], p.id[i]);
+            let normal = body.normal(&rotations[b], p.id[i]);
             for d in 0..D {
                 p.pos[d][i] = body.state.centre[d] + arm[d];
+                p.normal[d][i] = normal[d];
             }
         }
         let mut crossings = 0;

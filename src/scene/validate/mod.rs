@@ -305,11 +305,19 @@ impl Validator<'_> {
             "is for a closed container: a periodic one cannot move (its frame's forces would not be periodic)",
         )?;
         let bodies = self.bodies(&f.body, &container, &obstacles, s)?;
-        self.check(
-            bodies.is_empty() || !periodic.contains(&true),
-            "body",
-            "cannot be in a periodic container: a body crossing the period is not supported; close the container or remove the [[body]] sections",
-        )?;
+        if periodic.contains(&true) {
+            // A held body stays inside the box; a free one could cross the period, and a
+            // body's particles are not wrapped.
+            if let Some(k) = bodies
+                .iter()
+                .position(|b| b.motion == BodyMotion::Free || b.release.is_some())
+            {
+                return Err(self.error(
+                    &format!("body[{k}].motion"),
+                    "is free (or `release` lets it go) in a periodic container: only bodies held for the whole run, \"fixed\" or \"prescribed\" without `release`, may be in one (a free body crossing the period is not supported); close the container or hold the body",
+                ));
+            }
+        }
 
         let name = match &s.name {
             Some(n) => {

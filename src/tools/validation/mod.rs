@@ -2,6 +2,7 @@
 //! the run's `particles.h5`, `stats.csv` and `probes.csv`: what `isph study` plots against wall time and what
 //! the validation tests assert. One file per case.
 
+pub mod cylinder_array;
 pub mod dam_break;
 pub mod density;
 pub mod hydrostatic;
@@ -29,17 +30,21 @@ pub enum Case {
     TaylorGreen,
     /// Wall pressures of a dam break against Lobovsky et al. (2014) (`lobovsky.rs`).
     LobovskyPressure,
+    /// Stokes flow through a square array of cylinders against Sangani & Acrivos (1982)
+    /// (`cylinder_array.rs`).
+    CylinderArray,
     /// Any flow: its density against ρ0 over every step (`density.rs`).
     Density,
 }
 
 impl Case {
-    pub const ALL: [Case; 6] = [
+    pub const ALL: [Case; 7] = [
         Case::Hydrostatic,
         Case::DamBreakFront,
         Case::Poiseuille,
         Case::TaylorGreen,
         Case::LobovskyPressure,
+        Case::CylinderArray,
         Case::Density,
     ];
 
@@ -51,6 +56,7 @@ impl Case {
             Case::Poiseuille => "poiseuille",
             Case::TaylorGreen => "taylor_green",
             Case::LobovskyPressure => "lobovsky_pressure",
+            Case::CylinderArray => "cylinder_array",
             Case::Density => "density",
         }
     }
@@ -63,6 +69,7 @@ impl Case {
             Case::Poiseuille => &poiseuille::DETAILS,
             Case::TaylorGreen => &taylor_green::DETAILS,
             Case::LobovskyPressure => &lobovsky::DETAILS,
+            Case::CylinderArray => &cylinder_array::DETAILS,
             Case::Density => &density::DETAILS,
         }
     }
@@ -139,6 +146,7 @@ pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, Va
         Case::Poiseuille => poiseuille::measure(scene, run_dir),
         Case::TaylorGreen => taylor_green::measure(scene, run_dir),
         Case::LobovskyPressure => lobovsky::measure(scene, run_dir),
+        Case::CylinderArray => cylinder_array::measure(scene, run_dir),
         Case::Density => density::measure(run_dir),
     }
 }
@@ -173,6 +181,7 @@ pub fn check(case: Case, scene: &Scene) -> Result<(), ValidationError> {
         Case::Poiseuille => poiseuille::Channel::of(scene).map(|_| ()),
         Case::TaylorGreen => taylor_green::Vortex::of(scene).map(|_| ()),
         Case::LobovskyPressure => lobovsky::Tank::new(scene).map(|_| ()),
+        Case::CylinderArray => cylinder_array::Cell::of(scene).map(|_| ()),
         Case::Density => Ok(()),
     }
 }
