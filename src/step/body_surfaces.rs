@@ -1,8 +1,8 @@
 //! The distance from each fluid particle to the surface of the body nearest it, for the
-//! no-slip of the viscous term at a body, Eq. (26): as
-//! at a wall (`ghosts::no_slip_difference`), the body's particles take the velocity of Morris,
-//! Fox & Zhu (1997) that puts the body's own velocity on its surface, not half a spacing inside
-//! it. Runs only in a scene with bodies.
+//! no-slip of the viscous term at a body, Eq. (26): as at a wall (`ghosts::no_slip_difference`),
+//! the body's particles take the velocity of Morris, Fox & Zhu (1997) that puts the body's own
+//! velocity on its surface, not half a spacing inside it (`sph::viscous_acceleration`). Runs
+//! only in a scene with bodies.
 
 use super::{Stage, StepSettings};
 use crate::bodies::Bodies;
