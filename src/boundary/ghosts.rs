@@ -156,10 +156,16 @@ pub fn no_slip_difference<const D: usize>(
     u_i: [f64; D],
     d_i: F64s,
 ) -> [F64s; D] {
-    let n_r = (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s));
-    let beta = morris_factor(n_r, d_i);
+    let beta = morris_factor(normal_projection(p, l), d_i);
     let u_b = motion(p, l).velocity;
     std::array::from_fn(|d| beta * (F64s::splat(u_i[d]) - u_b[d]))
+}
+
+/// n_b·r_ib of the particles b in lanes `l` seen from particle i, with n_b their normals
+/// (`Particles::normal`: zero for fluid).
+#[inline(always)]
+pub fn normal_projection<const D: usize>(p: &Particles<D>, l: &Lanes<D>) -> F64s {
+    (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s))
 }
 
 /// β = 1 + d_b/d_i of the no-slip velocity of Morris, Fox & Zhu (1997) of a boundary particle
@@ -221,19 +227,35 @@ impl<const D: usize> Ghosts<'_, D> {
     }
 }
 
-/// The wall particle b nearest to particle i closer than `within`, with r_ib and |r_ib|, if any.
-pub fn nearest_wall<const D: usize>(
+/// The boundary particle b nearest to particle i closer than `within`, among the particles of
+/// `kinds` that `keep` takes (a wall's; a body's, sorted with the fluid), with r_ib and |r_ib|,
+/// if any.
+pub fn nearest_boundary<const D: usize>(
     nb: &Neighbours<D>,
     within: f64,
     i: usize,
+    kinds: &[Kind],
+    keep: impl Fn(usize) -> bool,
 ) -> Option<(usize, [f64; D], f64)> {
     let mut nearest = (within, None);
-    nb.for_each_of(i, &[Kind::Wall], |j, rij, r| {
-        if r < nearest.0 {
+    nb.for_each_of(i, kinds, |j, rij, r| {
+        if r < nearest.0 && keep(j) {
             nearest = (r, Some((j, rij)));
         }
     });
     nearest.1.map(|(j, rij)| (j, rij, nearest.0))
+}
+
+/// Distance to a boundary's face of a particle at r_ib from boundary particle b, whose
+/// outward normal is `normal` and whose centre lies `depth` behind the face: n·r_ib − depth,
+/// at least a quarter spacing (a particle pressed against the face).
+pub fn face_distance<const D: usize>(
+    normal: [f64; D],
+    r_ib: [f64; D],
+    depth: f64,
+    spacing: f64,
+) -> f64 {
+    (dot(r_ib, normal) - depth).max(0.25 * spacing)
 }
 
 /// The face of the wall nearest to a fluid particle.
@@ -258,10 +280,11 @@ pub fn nearest_face<const D: usize>(
     within: f64,
     i: usize,
 ) -> Option<Face<D>> {
-    let (b, r_ib, reach) = nearest_wall(nb, within, i)?;
+    let (b, r_ib, reach) = nearest_boundary(nb, within, i, &[Kind::Wall], |_| true)?;
     let normal = p.wall_normal(b);
     Some(Face {
-        distance: (dot(r_ib, normal) - 0.5 * spacing).max(0.25 * spacing),
+        // A wall particle's centre lies half a spacing behind the face.
+        distance: face_distance(normal, r_ib, 0.5 * spacing, spacing),
         normal,
         reach,
     })

@@ -153,7 +153,7 @@ pub fn viscous_acceleration<const D: usize>(
 /// spacing inside it. Both particles of a pair take the same β, so the viscous forces between
 /// the fluid and a body stay equal and opposite and the body feels what it does to the fluid.
 #[derive(Clone, Copy)]
-enum BodyNoSlip<'a> {
+enum BodyNoSlip<'a, const D: usize> {
     /// i is a fluid particle at `distance` from the nearest body's surface: a body particle b
     /// takes β = n_b·r_ib/distance (its outward normal in `Particles::normal`, zero for a
     /// fluid particle, whose β is 1).
@@ -161,7 +161,7 @@ enum BodyNoSlip<'a> {
     /// i is a body particle with outward normal `normal`: a fluid particle j takes
     /// β = n_i·r_ji/d_j, d_j from `distances` (infinite for a body particle: β = 1).
     Body {
-        normal: [f64; 3],
+        normal: [f64; D],
         distances: &'a [f64],
     },
 }
@@ -172,15 +172,15 @@ fn body_no_slip<'a, const D: usize>(
     p: &Particles<D>,
     distances: &'a [f64],
     i: usize,
-) -> Option<BodyNoSlip<'a>> {
+) -> Option<BodyNoSlip<'a, D>> {
     match p.kind[i] {
         Kind::Fluid => distances[i].is_finite().then_some(BodyNoSlip::Fluid {
             distance: distances[i],
         }),
         Kind::Body => {
             let n = p.wall_normal(i);
-            n.iter().any(|&c| c != 0.0).then(|| BodyNoSlip::Body {
-                normal: std::array::from_fn(|d| if d < D { n[d] } else { 0.0 }),
+            n.iter().any(|&c| c != 0.0).then_some(BodyNoSlip::Body {
+                normal: n,
                 distances,
             })
         }
@@ -188,14 +188,13 @@ fn body_no_slip<'a, const D: usize>(
     }
 }
 
-impl BodyNoSlip<'_> {
+impl<const D: usize> BodyNoSlip<'_, D> {
     /// β of the pairs of particle i with the particles in lanes `l` (of the fluid's group).
     #[inline(always)]
-    fn factor<const D: usize>(&self, p: &Particles<D>, l: &Lanes<D>) -> F64s {
+    fn factor(&self, p: &Particles<D>, l: &Lanes<D>) -> F64s {
         match *self {
             BodyNoSlip::Fluid { distance } => {
-                let n_r = (0..D).fold(F64s::ZERO, |s, d| l.load(&p.normal[d]).mul_add(l.rij[d], s));
-                ghosts::morris_factor(n_r, F64s::splat(distance))
+                ghosts::morris_factor(ghosts::normal_projection(p, l), F64s::splat(distance))
             }
             BodyNoSlip::Body { normal, distances } => {
                 // r_ji = −r_ij.

@@ -6,9 +6,9 @@
 
 use super::{Stage, StepSettings};
 use crate::bodies::Bodies;
+use crate::boundary::ghosts;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill;
-use crate::math::vector::dot;
 use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
 
@@ -41,16 +41,15 @@ impl BodySurfaces {
             if p.kind[i] != Kind::Fluid || !bodies.near(p.position(i), support) {
                 return f64::INFINITY;
             }
-            let mut nearest = (support, None);
-            nb.for_each_of(i, &[Kind::Fluid], |j, r_ij, r| {
-                if p.kind[j] == Kind::Body && r < nearest.0 {
-                    nearest = (r, Some((j, r_ij)));
-                }
-            });
-            nearest.1.map_or(f64::INFINITY, |(b, r_ib)| {
-                let depth = bodies.depth(p.fluid[b] as usize, p.id[b]);
-                (dot(p.wall_normal(b), r_ib) - depth).max(0.25 * spacing)
-            })
+            // A body's particles are sorted with the fluid's.
+            let is_body = |j: usize| p.kind[j] == Kind::Body;
+            ghosts::nearest_boundary(nb, support, i, &[Kind::Fluid], is_body).map_or(
+                f64::INFINITY,
+                |(b, r_ib, _)| {
+                    let depth = bodies.depth(p.fluid[b] as usize, p.id[b]);
+                    ghosts::face_distance(p.wall_normal(b), r_ib, depth, spacing)
+                },
+            )
         });
     }
 

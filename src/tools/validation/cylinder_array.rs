@@ -13,8 +13,8 @@
 //! 1.14 at 0.3).
 //!
 //! The error is K of the last frame over the reference, less 1. U is the mean over the box of
-//! the velocity along the force: each fluid particle holds dx² (dx³ in 3D) of the box, the
-//! body's particles none. Details: K itself, the reference, Φ of the circle and Φ of the
+//! the velocity along the force: each fluid particle holds dx² of the box, the body's particles
+//! none. Details: K itself, the reference, Φ of the circle and Φ of the
 //! body's lattice points.
 
 use super::{last_frame, unsuitable, Case, Measured, ValidationError};
