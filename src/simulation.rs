@@ -10,7 +10,7 @@ use crate::math::kernel::Kernel;
 use crate::math::memory::ArraySize;
 use crate::neighbours::cell_list::CellList;
 use crate::particles::Particles;
-use crate::scene::{Probe, ProbeField, Scene};
+use crate::scene::{Aabb, Probe, ProbeField, Scene};
 use crate::solver::krylov::{SolverError, SolverParams};
 use crate::solver::ppe::PressureOperator;
 use crate::sph;
@@ -254,16 +254,29 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// The values of `probes` as the particles stand, in the order of their columns in
-    /// `probes.csv` (`Probe::columns`): the Shepard interpolation of the fluid (`sph::probe`).
-    pub fn probe_values(&self, probes: &[Probe]) -> Vec<f64> {
+    /// `probes.csv` (`Probe::columns`): the Shepard interpolation of the fluid, or a gauge's
+    /// surface height on its vertical line across `container` (`sph::probe`; NaN where no water
+    /// is under it).
+    pub fn probe_values(&self, probes: &[Probe], container: &Aabb) -> Vec<f64> {
         let kernel = self.kernel();
+        let spacing = self.stepper.settings.spacing;
+        let periods = &self.periods;
+        let sample = |point| {
+            let full = probe::full_fraction(&kernel, spacing, container, periods, point);
+            let wet = probe::SURFACE_FRACTION * full;
+            probe::sample(&self.particles, &kernel, periods, point, wet)
+        };
+        let gauge = |point| {
+            probe::surface_height(&self.particles, &kernel, periods, point, container, spacing)
+                .unwrap_or(f64::NAN)
+        };
         let mut values = Vec::new();
         for p in probes {
-            let point = std::array::from_fn(|d| p.point[d]);
-            let sample = probe::sample(&self.particles, &kernel, &self.periods, point);
+            let point: [f64; D] = std::array::from_fn(|d| p.point[d]);
             match p.field {
-                ProbeField::Pressure => values.push(sample.pressure),
-                ProbeField::Velocity => values.extend(sample.velocity),
+                ProbeField::Pressure => values.push(sample(point).pressure),
+                ProbeField::Velocity => values.extend(sample(point).velocity),
+                ProbeField::Elevation => values.push(gauge(point)),
             }
         }
         values

@@ -72,11 +72,11 @@ fn dam_break_3d_runs_half_a_second() {
 /// where the experiment's rise is slow) moves by up to 7 points between draws, so that the
 /// median of three is a draw of its own. A sensor whose centre lies below the first layer of
 /// fluid particles (half a spacing, 3.75 mm: sensor 1, at 3 mm) is not resolved and not asked
-/// for. Measured at H/40 (frames every 0.015, 0.02, 0.025, 0.03, 0.035, 0.04 s): sensor 2 +0.0 /
-/// −0.2 / −0.1 / −0.7 / −0.4 / −0.4%, sensor 3 −2.3 / −2.5 / −2.4 / −3.0 / −2.7 / −2.7%, sensor 4
-/// −1.9 / −3.6 / −7.8 / −2.3 / −0.7 / −2.3%; medians −0.3%, −2.6%, −2.3%
-/// (docs/accuracy.md, "Wall pressures against Lobovsky et al. 2014"). At this spacing the first
-/// water reaches sensors 1–3 in the same step, so their onsets differ by the experiment's only.
+/// for. Measured at H/40 (frames every 0.015, 0.02, 0.025, 0.03, 0.035, 0.04 s): sensor 2 +0.6 /
+/// −0.2 / +0.6 / −0.1 / +0.7 / +0.7%, sensor 3 −0.8 / −0.0 / −0.2 / +0.1 / −0.6 / −0.3%, sensor 4
+/// −2.8 / −1.2 / −3.5 / −5.4 / +0.4 / −1.5%; medians +0.6%, −0.25%, −2.1% (docs/accuracy.md,
+/// "Wall pressures against Lobovsky et al. 2014"). With probes that read the first particle
+/// within their support at full weight, a film 3h from sensor 4 gave it its onset: median −4.1%.
 #[test]
 fn wall_pressure_onsets_follow_lobovsky() {
     let scene = shipped_scene("dam_break_lobovsky_2d.toml");

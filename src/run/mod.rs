@@ -453,7 +453,12 @@ impl<'a, const D: usize> Driver<'a, D> {
             ppe_total += step.ppe_iterations as u64;
             self.output.stats.row(&step, self.wall_seconds())?;
             if let Some(probes) = &mut self.output.probes {
-                probes.row(self.sim.time, &self.sim.probe_values(&self.scene.probes))?;
+                probes.row(
+                    self.sim.time,
+                    &self
+                        .sim
+                        .probe_values(&self.scene.probes, &self.scene.container),
+                )?;
             }
             progress.update(&step);
             self.write_frame_if_due()?;

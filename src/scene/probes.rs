@@ -7,15 +7,19 @@ pub enum ProbeField {
     Pressure,
     /// The velocity [m/s]: one column per component.
     Velocity,
+    /// A wave gauge: the height [m] of the free surface on the vertical line through the point
+    /// (its last coordinate is the height and is not read): one column.
+    Elevation,
 }
 
 impl ProbeField {
-    pub const NAMES: [&'static str; 2] = ["pressure", "velocity"];
+    pub const NAMES: [&'static str; 3] = ["pressure", "velocity", "elevation"];
 
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
             "pressure" => Some(Self::Pressure),
             "velocity" => Some(Self::Velocity),
+            "elevation" => Some(Self::Elevation),
             _ => None,
         }
     }
@@ -24,6 +28,7 @@ impl ProbeField {
         match self {
             Self::Pressure => "pressure",
             Self::Velocity => "velocity",
+            Self::Elevation => "elevation",
         }
     }
 }
@@ -43,7 +48,7 @@ impl Probe {
     /// (, `name_z`) for a velocity.
     pub fn columns(&self) -> Vec<String> {
         match self.field {
-            ProbeField::Pressure => vec![self.name.clone()],
+            ProbeField::Pressure | ProbeField::Elevation => vec![self.name.clone()],
             ProbeField::Velocity => ["x", "y", "z"][..self.point.len()]
                 .iter()
                 .map(|axis| format!("{}_{axis}", self.name))

@@ -441,16 +441,16 @@ fn net_compression(
 ///
 /// The divergence the particles carry into the step, ∇·uⁿ, is mostly the last drift's second
 /// half, −(Δt_prev/2) ∂_a u_b ∂_b u_a. Taken out over Δt, the step's pressure reads
-/// (1 + Δt_prev/Δt)/2 times the flow's (its impulse P Δt is the flow's). On a sliver of a step
-/// (`StepLength::carried_time`: a last step just past a frame) it is taken out over the last
-/// step's Δt_prev instead: ∇·u* − (1 − Δt/Δt_prev) ∇·uⁿ. The sliver's pressure is then the
+/// (1 + Δt_prev/Δt)/2 times the flow's (its impulse P Δt is the flow's); the steps cut to land
+/// on a frame share the cut, so that ratio stays near 1 (`time_step::length`). On a sliver of
+/// a step (`StepLength::carried_time`: a last step just past a frame) it is taken out over the
+/// last step's Δt_prev instead: ∇·u* − (1 − Δt/Δt_prev) ∇·uⁿ. The sliver's pressure is then the
 /// flow's, and it leaves the next step the divergence the last step left it, as if it had not
 /// been taken. Over the sliver, a 1e-5 s tail after 3e-4 s steps read 4.6 times the flow's mean
 /// pressure in the frame it ends on (docs/stabilisation.md, "A short step relaxes less"). The
 /// velocity keeps (1 − Δt/Δt_prev) ∇·uⁿ at the midpoint of the sliver's drift, which costs
-/// nothing over a sliver; on every step cut to land on a frame (the halves too) that braked the
-/// Taylor–Green vortex by 0.6% of its kinetic energy in 0.3 L/U, so the halves take it out
-/// over Δt. What the step itself adds to u* (its forces; a held body's hold) is taken out over
+/// nothing over a sliver; on every step cut to land on a frame that braked the Taylor–Green
+/// vortex by 0.6% of its kinetic energy in 0.3 L/U, so those take it out over Δt. What the step itself adds to u* (its forces; a held body's hold) is taken out over
 /// Δt.
 fn divergence_source<const D: usize>(
     nb: &Neighbours<D>,

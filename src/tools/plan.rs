@@ -5,7 +5,7 @@
 
 use crate::math::kernel::KernelKind;
 use crate::scene::{BodyMotion, Effects, Scene, BYTES_PER_CONTAINER_POINT};
-use crate::scene::{CubeRule, Probe, SurfaceSettings};
+use crate::scene::{CubeRule, Probe, ProbeField, SurfaceSettings};
 use crate::simulation::{NoFluid, Simulation};
 use std::fmt;
 
@@ -260,11 +260,15 @@ impl fmt::Display for Plan {
             writeln!(f, "at every frame: {}", surface_line(s, self.dimensions))?;
         }
         if !self.probes.is_empty() {
-            writeln!(f, "after every step, into probes.csv (the Shepard sum of the fluid particles within the kernel support; no array):")?;
+            writeln!(f, "after every step, into probes.csv (the Shepard sum of the fluid particles within the kernel support where the water covers the point; a gauge, the height where the fluid fraction falls through half its full value on the vertical line; no array):")?;
             for p in &self.probes {
+                let place = match p.field {
+                    ProbeField::Elevation => "on the vertical line through",
+                    ProbeField::Pressure | ProbeField::Velocity => "at",
+                };
                 writeln!(
                     f,
-                    "      {:<25} {} at {:?} m  columns {}",
+                    "      {:<25} {} {place} {:?} m  columns {}",
                     p.name,
                     p.field.name(),
                     p.point,
