@@ -179,7 +179,7 @@ enum Command {
     /// Measure the error of a finished run against a reference solution or experiment
     /// (the error measures of `isph study`, docs/study-format.md).
     Measure {
-        /// The error measure: hydrostatic, dam_break_front, poiseuille, taylor_green, lobovsky_pressure, cylinder_array or density.
+        /// The error measure: hydrostatic, dam_break_front, poiseuille, taylor_green, lobovsky_pressure, cylinder_array, wave_flume or density.
         measure: String,
         /// The scene the run was made from.
         scene: PathBuf,

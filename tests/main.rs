@@ -34,3 +34,4 @@ mod surface_runs;
 mod two_fluids;
 mod validation;
 mod wall_contact;
+mod waves;

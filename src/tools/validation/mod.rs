@@ -9,6 +9,7 @@ pub mod hydrostatic;
 pub mod lobovsky;
 pub mod poiseuille;
 pub mod taylor_green;
+pub mod wave_flume;
 
 use crate::io::frames::{Frame, FrameReader};
 use crate::io::OutputError;
@@ -33,18 +34,22 @@ pub enum Case {
     /// Stokes flow through a square array of cylinders against Sangani & Acrivos (1982)
     /// (`cylinder_array.rs`).
     CylinderArray,
+    /// Regular waves from a piston wave maker against Biesel's transfer function
+    /// (`wave_flume.rs`).
+    WaveFlume,
     /// Any flow: its density against ρ0 over every step (`density.rs`).
     Density,
 }
 
 impl Case {
-    pub const ALL: [Case; 7] = [
+    pub const ALL: [Case; 8] = [
         Case::Hydrostatic,
         Case::DamBreakFront,
         Case::Poiseuille,
         Case::TaylorGreen,
         Case::LobovskyPressure,
         Case::CylinderArray,
+        Case::WaveFlume,
         Case::Density,
     ];
 
@@ -57,6 +62,7 @@ impl Case {
             Case::TaylorGreen => "taylor_green",
             Case::LobovskyPressure => "lobovsky_pressure",
             Case::CylinderArray => "cylinder_array",
+            Case::WaveFlume => "wave_flume",
             Case::Density => "density",
         }
     }
@@ -70,6 +76,7 @@ impl Case {
             Case::TaylorGreen => &taylor_green::DETAILS,
             Case::LobovskyPressure => &lobovsky::DETAILS,
             Case::CylinderArray => &cylinder_array::DETAILS,
+            Case::WaveFlume => &wave_flume::DETAILS,
             Case::Density => &density::DETAILS,
         }
     }
@@ -147,6 +154,7 @@ pub fn measure(case: Case, scene: &Scene, run_dir: &Path) -> Result<Measured, Va
         Case::TaylorGreen => taylor_green::measure(scene, run_dir),
         Case::LobovskyPressure => lobovsky::measure(scene, run_dir),
         Case::CylinderArray => cylinder_array::measure(scene, run_dir),
+        Case::WaveFlume => wave_flume::measure(scene, run_dir),
         Case::Density => density::measure(run_dir),
     }
 }
@@ -182,6 +190,7 @@ pub fn check(case: Case, scene: &Scene) -> Result<(), ValidationError> {
         Case::TaylorGreen => taylor_green::Vortex::of(scene).map(|_| ()),
         Case::LobovskyPressure => lobovsky::Tank::new(scene).map(|_| ()),
         Case::CylinderArray => cylinder_array::Cell::of(scene).map(|_| ()),
+        Case::WaveFlume => wave_flume::Flume::of(scene).map(|_| ()),
         Case::Density => Ok(()),
     }
 }
