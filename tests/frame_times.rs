@@ -6,11 +6,11 @@
 //! the flow's pressure.
 
 use std::f64::consts::PI;
-use std::path::Path;
 
 use crate::common::{
     read_frame, run_scene, scene_from_text, shipped_scene, stats_column, water_block_scene, TempDir,
 };
+use isph::io::probes;
 use isph::scene::{Probe, ProbeField, Scene};
 
 fn scene(end_time: f64, interval: f64) -> Scene {
@@ -126,21 +126,6 @@ fn a_short_last_step_reads_the_flows_pressure() {
     );
 }
 
-/// Column `name` of a run's probes.csv.
-fn probe_column(out: &Path, name: &str) -> Vec<f64> {
-    let text = std::fs::read_to_string(out.join("probes.csv")).unwrap();
-    let mut lines = text.lines();
-    let col = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .position(|c| c == name)
-        .expect("probe column");
-    lines
-        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
-        .collect()
-}
-
 /// The steps cut to land on a frame read the flow's pressure. The Taylor–Green vortex's pressure
 /// is all the projection's answer to the divergence the particles' drift makes, half of it
 /// carried into a step from the last one's drift and taken out over this one's Δt, so a step
@@ -172,8 +157,10 @@ fn steps_cut_to_land_on_a_frame_read_the_flows_pressure() {
     let cut_steps = dt.iter().filter(|&&step| step < 0.99 * dt[0]).count();
     assert!(cut_steps >= 6, "{cut_steps} steps shorter than the limit");
     let decay = 4.0 * 0.01 * (2.0 * PI).powi(2);
+    let (columns, rows) = probes::read(dir.path()).unwrap();
     for (name, sign) in [("high", 1.0), ("low", -1.0)] {
-        let pressure = probe_column(dir.path(), name);
+        let col = columns.iter().position(|c| c == name).unwrap();
+        let pressure: Vec<f64> = rows.iter().map(|r| r[col]).collect();
         // Past the first steps from rest; each step's pressure at the middle of its drift.
         for k in (0..time.len()).filter(|&k| time[k] > 0.05) {
             let exact = sign * 500.0 * (-decay * (time[k] - 0.5 * dt[k])).exp();
