@@ -19,8 +19,9 @@
 //! experiment's), `onset_Pk` (T) and `plateau_Pk` (P/(ρ0 g H)) of the run; a plateau whose window
 //! the run did not reach, or an onset it did not, is NaN.
 
-use super::{first_block, surge_vertical, unsuitable, Case, Measured, ValidationError};
-use crate::io::probes;
+use super::{
+    first_block, surge_vertical, unsuitable, Case, Measured, ProbeCurves, ValidationError,
+};
 use crate::scene::{ProbeField, Scene};
 use std::path::Path;
 
@@ -183,21 +184,13 @@ impl Tank {
 pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
     let case = Case::LobovskyPressure;
     let tank = Tank::new(scene)?;
-    let (columns, rows) = probes::read(run_dir)?;
-    let run_error = |message: String| ValidationError::Run {
-        case,
-        dir: run_dir.to_owned(),
-        message,
-    };
+    let probes = ProbeCurves::read(case, run_dir)?;
     let mut values = [f64::NAN; 16];
     for (k, sensor) in SENSORS.iter().enumerate() {
-        let col = columns
-            .iter()
-            .position(|c| c == sensor.name)
-            .ok_or_else(|| run_error(format!("its probes.csv has no column {}", sensor.name)))?;
-        let run: Vec<(f64, f64)> = rows
-            .iter()
-            .map(|r| (r[0] * tank.time_scale, r[col] / tank.pressure_scale))
+        let run: Vec<(f64, f64)> = probes
+            .curve(sensor.name)?
+            .into_iter()
+            .map(|(t, p)| (t * tank.time_scale, p / tank.pressure_scale))
             .collect();
         let experiment = sensor.curve();
         let exp_onset = onset(&experiment, ONSET_LEVEL).expect("every sensor's curve rises");
@@ -210,8 +203,8 @@ pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationErro
         values[12 + k] = run_plateau.unwrap_or(nan);
     }
     if values[..4].iter().all(|e| e.is_nan()) {
-        let end = rows.last().map_or(0.0, |r| r[0]);
-        return Err(run_error(format!(
+        let end = probes.end();
+        return Err(probes.error(format!(
             "no probe reached {ONSET_LEVEL} ρ0 g H by its end at t = {end} s (T = {:.3})",
             end * tank.time_scale
         )));

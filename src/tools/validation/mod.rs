@@ -249,6 +249,50 @@ fn surge_vertical(case: Case, scene: &Scene) -> Result<(usize, f64), ValidationE
     Ok((v, g))
 }
 
+/// A run's probes.csv, read for `case`: each probe's column as a curve of (t, value).
+struct ProbeCurves {
+    case: Case,
+    dir: PathBuf,
+    columns: Vec<String>,
+    rows: Vec<Vec<f64>>,
+}
+
+impl ProbeCurves {
+    fn read(case: Case, run_dir: &Path) -> Result<Self, ValidationError> {
+        let (columns, rows) = crate::io::probes::read(run_dir)?;
+        Ok(Self {
+            case,
+            dir: run_dir.to_owned(),
+            columns,
+            rows,
+        })
+    }
+
+    /// The column `name` against time; an error names the column the file lacks.
+    fn curve(&self, name: &str) -> Result<Vec<(f64, f64)>, ValidationError> {
+        let col = self
+            .columns
+            .iter()
+            .position(|c| c == name)
+            .ok_or_else(|| self.error(format!("its probes.csv has no column {name}")))?;
+        Ok(self.rows.iter().map(|r| (r[0], r[col])).collect())
+    }
+
+    /// The time of the last row (0 without rows).
+    fn end(&self) -> f64 {
+        self.rows.last().map_or(0.0, |r| r[0])
+    }
+
+    /// What is wrong with the run, for `case`.
+    fn error(&self, message: String) -> ValidationError {
+        ValidationError::Run {
+            case: self.case,
+            dir: self.dir.clone(),
+            message,
+        }
+    }
+}
+
 /// The last frame of the run in `run_dir`.
 fn last_frame(case: Case, run_dir: &Path) -> Result<Frame, ValidationError> {
     let reader = FrameReader::open(run_dir)?;

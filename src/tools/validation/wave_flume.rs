@@ -21,8 +21,7 @@
 //! whole periods between the front and the reflection. Details: H_Biesel, the wavelength, the
 //! count of those gauges, and their signed errors' smallest, largest and mean.
 
-use super::{first_block, unsuitable, vertical, Case, Measured, ValidationError};
-use crate::io::probes;
+use super::{first_block, unsuitable, vertical, Case, Measured, ProbeCurves, ValidationError};
 use crate::math::rotation::{apply, inverse_on_span};
 use crate::scene::trajectory::Path as Motion;
 use crate::scene::{BodyMotion, ProbeField, Scene};
@@ -176,32 +175,22 @@ pub fn first_harmonic_height(samples: &[(f64, f64)], frequency: f64) -> f64 {
 }
 
 pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationError> {
-    let case = Case::WaveFlume;
     let flume = Flume::of(scene)?;
-    let (columns, rows) = probes::read(run_dir)?;
-    let run_error = |message: String| ValidationError::Run {
-        case,
-        dir: run_dir.to_owned(),
-        message,
-    };
-    let end = rows.last().map_or(0.0, |r| r[0]);
+    let probes = ProbeCurves::read(Case::WaveFlume, run_dir)?;
+    let end = probes.end();
     let reference = flume.reference_height();
     let mut errors = Vec::new();
     for (name, distance) in &flume.gauges {
-        let col = columns
-            .iter()
-            .position(|c| c == name)
-            .ok_or_else(|| run_error(format!("its probes.csv has no column {name}")))?;
+        let curve = probes.curve(name)?;
         let Some((start, stop)) = flume.window(*distance, end) else {
             continue;
         };
-        let samples: Vec<(f64, f64)> = rows
-            .iter()
-            .filter(|r| (start..=stop).contains(&r[0]))
-            .map(|r| (r[0], r[col]))
+        let samples: Vec<(f64, f64)> = curve
+            .into_iter()
+            .filter(|(t, _)| (start..=stop).contains(t))
             .collect();
         if samples.iter().any(|s| !s.1.is_finite()) {
-            return Err(run_error(format!(
+            return Err(probes.error(format!(
                 "the gauge {name} reads no water (NaN) between t = {start} and {stop} s"
             )));
         }
@@ -209,7 +198,7 @@ pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationErro
         errors.push(height / reference - 1.0);
     }
     if errors.is_empty() {
-        return Err(run_error(format!(
+        return Err(probes.error(format!(
             "the run, to t = {end} s, or the flume holds less than two whole periods at every gauge between the wave train's front (at c_g = {:.3} m/s, plus {SETTLING_PERIODS} periods) and the far wall's reflection (at √(gh) = {:.3} m/s): a longer run or flume, or a gauge nearer the piston",
             flume.group_velocity(),
             (flume.gravity * flume.depth).sqrt()
