@@ -1,7 +1,9 @@
 //! The body force per unit mass f_i on each fluid and body particle where it is not gravity
 //! alone (`ghosts::BodyForce`): in a moving container the frame's (`moving_frame`); on a free
 //! body's particles that plus the body's external force over its mass, so the pressure solve
-//! sees the body accelerate and its added mass is implicit; on a fixed or prescribed body's
+//! sees the body accelerate and its added mass is implicit, and the rigid part of the last
+//! step's pressure acceleration less their own, so that the solve starts from a body that moves
+//! as one (`rigidise_free_bodies`); on a fixed or prescribed body's
 //! particles the acceleration that takes each to its rigid velocity at the end of the step,
 //! plus the pressure acceleration the last step's pressure gave it, ∇Pⁿ/ρ0: the corrector
 //! takes the new one off, so the solve leaves the body at its rigid velocity up to the change
@@ -17,15 +19,17 @@
 
 use super::corrector::pressure_gradient;
 use super::free_surface::Surface;
+use super::hydrostatic_split::surface_excess;
 use super::{Stage, StepSettings};
-use crate::bodies::{rigid_velocity, Bodies};
+use crate::bodies::{rigid_velocity, Bodies, RigidTarget};
 use crate::boundary::moving_frame::{FrameForce, MovingFrame};
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_vector;
-use crate::math::rotation::{cross, Vec3};
+use crate::math::rotation::{apply, cross, inverse_on_span, to_world, Mat3, Vec3};
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Kind, Particles};
 use crate::sph::interface;
+use rayon::prelude::*;
 
 pub const NAME: &str = "body forces";
 
@@ -102,6 +106,9 @@ impl<const D: usize> BodyForces<D> {
         if bodies.is_empty() {
             return;
         }
+        self.rigidise_free_bodies(
+            nb, p, bodies, set, surface, interfaces, &targets, &ambient, nf,
+        );
         for a in &mut self.ghost {
             a.resize(nf, 0.0);
         }
@@ -114,6 +121,63 @@ impl<const D: usize> BodyForces<D> {
                 std::array::from_fn(|d| force[d][i])
             }
         });
+    }
+
+    /// Adds to each free body's particles the rigid part of the pressure acceleration the last
+    /// step's pressure gives them less their own, A + α × r_ic − a_i, with
+    /// a_i = −(∇Pⁿ_i + E_i)/ρ0_i (E_i the hydrostatic split's part, `hydrostatic_split`), and A
+    /// and α the body's linear and angular acceleration under the forces m_i a_i:
+    /// M A = Σ m_i a_i, I α = Σ r_ic × m_i a_i. The sum of the added forces and of their
+    /// moments is zero: the body's motion is that of the same solve. But the solve starts from
+    /// a body whose particles the last pressure moves together, as one body, and the pressure
+    /// that changes over the step is what moves them apart. Without it each particle of a
+    /// floating body yields to the pressure as fluid of the body's density would: at rest at its
+    /// draft the wet part of a box at half the water's density rises at |g| Δt in the solve and
+    /// its dry part falls as fast, the water under its keel follows the keel up, and the
+    /// body is put back to its rigid motion after the solve while the water keeps that kick
+    /// (docs/bodies.md, "The coupling").
+    #[allow(clippy::too_many_arguments)]
+    fn rigidise_free_bodies(
+        &mut self,
+        nb: &Neighbours<D>,
+        p: &Particles<D>,
+        bodies: &Bodies,
+        set: &StepSettings<D>,
+        surface: &Surface<D>,
+        interfaces: Option<interface::Field<D>>,
+        targets: &[Option<(RigidTarget, Mat3)>],
+        ambient: &(impl Fn(usize) -> [f64; D] + Sync),
+        nf: usize,
+    ) {
+        let members: Vec<usize> = (0..nf)
+            .filter(|&i| p.kind[i] == Kind::Body && targets[p.fluid[i] as usize].is_none())
+            .collect();
+        if members.is_empty() {
+            return;
+        }
+        let own = pressure_accelerations(
+            nb,
+            p,
+            set,
+            surface,
+            interfaces,
+            &self.force,
+            ambient,
+            &members,
+        );
+        let rotations: Vec<Mat3> = bodies.bodies.iter().map(|b| b.rotation()).collect();
+        let arm = |i: usize| {
+            let b = p.fluid[i] as usize;
+            bodies.bodies[b].arm(&rotations[b], p.id[i])
+        };
+        let rigid = rigid_accelerations(p, bodies, &rotations, &members, &own, arm);
+        for (&i, a) in members.iter().zip(&own) {
+            let (linear, angular) = rigid[p.fluid[i] as usize];
+            let turn = cross(angular, arm(i));
+            for d in 0..D {
+                self.force[d][i] += linear[d] + turn[d] - a[d];
+            }
+        }
     }
 
     /// f_i of the last `run`: what the predictor adds.
@@ -205,6 +269,76 @@ fn ambient<const D: usize>(
     }
 }
 
+/// a_i = −(∇Pⁿ_i + E_i)/ρ0_i of the body particles `members`: the acceleration the last
+/// step's pressure gives each, with the hydrostatic split's part E_i where the scene has
+/// `interfaces` (`hydrostatic_split`; `force` the fluid particles' body force).
+#[allow(clippy::too_many_arguments)]
+fn pressure_accelerations<const D: usize>(
+    nb: &Neighbours<D>,
+    p: &Particles<D>,
+    set: &StepSettings<D>,
+    surface: &Surface<D>,
+    interfaces: Option<interface::Field<D>>,
+    force: &[Vec<f64>; D],
+    ambient: &(impl Fn(usize) -> [f64; D] + Sync),
+    members: &[usize],
+) -> Vec<[f64; D]> {
+    let body: Vec<f64> = match interfaces {
+        Some(_) => (0..force[0].len())
+            .map(|i| f64::from(p.kind[i] == Kind::Body))
+            .collect(),
+        None => Vec::new(),
+    };
+    members
+        .par_iter()
+        .map(|&i| {
+            let ghosts = set.ghost_force_of(ambient(i));
+            let mut grad = pressure_gradient(nb, p, &p.pressure, surface, ghosts, interfaces, i);
+            if let Some(field) = interfaces {
+                let e = surface_excess(nb, p, surface, field, &body, force, i);
+                for d in 0..D {
+                    grad[d] += e[d];
+                }
+            }
+            grad.map(|g| -g / p.rest_density[i])
+        })
+        .collect()
+}
+
+/// Each body's (A, α) under the forces m_i a_i on its particles `members` (`accelerations`,
+/// in the same order), with `arm` a particle's offset from its body's centre of mass:
+/// M A = Σ m_i a_i, I α = Σ r_ic × m_i a_i, I the inertia turned by `rotations`. Summed in
+/// index order on one thread: the same bits whatever the thread count.
+fn rigid_accelerations<const D: usize>(
+    p: &Particles<D>,
+    bodies: &Bodies,
+    rotations: &[Mat3],
+    members: &[usize],
+    accelerations: &[[f64; D]],
+    arm: impl Fn(usize) -> Vec3,
+) -> Vec<(Vec3, Vec3)> {
+    let count = bodies.bodies.len();
+    let (mut sum, mut moment) = (vec![[0.0; 3]; count], vec![[0.0; 3]; count]);
+    for (&i, a) in members.iter().zip(accelerations) {
+        let b = p.fluid[i] as usize;
+        let ma: Vec3 = std::array::from_fn(|d| if d < D { p.mass[i] * a[d] } else { 0.0 });
+        let t = cross(arm(i), ma);
+        for d in 0..3 {
+            sum[b][d] += ma[d];
+            moment[b][d] += t[d];
+        }
+    }
+    bodies
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(b, body)| {
+            let inverse = inverse_on_span(&to_world(&rotations[b], &body.inertia));
+            (sum[b].map(|s| s / body.mass), apply(&inverse, moment[b]))
+        })
+        .collect()
+}
+
 impl<const D: usize> Stage<D> for BodyForces<D> {
     fn name(&self) -> &'static str {
         NAME
@@ -216,7 +350,7 @@ impl<const D: usize> Stage<D> for BodyForces<D> {
         } else {
             "gravity"
         };
-        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass; on a fixed, prescribed or resting body's the acceleration to its rigid velocity at the step's end plus the last step's ∇P/ρ0, and a resting body's own weight and external force for its supports; beside a body's particles the wall ghosts carry the water's weight, ρ_w f, not the body's")
+        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass and the rigid part of the last step's pressure acceleration less their own (A + α × r − a_i, zero net force and moment); on a fixed, prescribed or resting body's the acceleration to its rigid velocity at the step's end plus the last step's ∇P/ρ0, and a resting body's own weight and external force for its supports; beside a body's particles the wall ghosts carry the water's weight, ρ_w f, not the body's")
     }
 
     fn arrays(&self) -> Vec<ArraySize> {

@@ -80,7 +80,7 @@ impl<const D: usize> HydrostaticSplit<D> {
 /// E_i = Σ_j V_j (1 − w_ij) h_ij L_i ∇W_ij over the pairs of particle i with particles of the
 /// other side of a body's surface (a fluid particle's with body particles, a body particle's
 /// with fluid particles; `body` flags the body particles), h_ij = ρ0_f f_f·(r_j − r_i).
-fn surface_excess<const D: usize>(
+pub(super) fn surface_excess<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     surface: &Surface<D>,
