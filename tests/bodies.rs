@@ -485,19 +485,17 @@ motion = "fixed"
     for (t, r) in &rows {
         assert!(r[..2] == rows[0].1[..2], "t = {t}: moved to {:?}", &r[..2]);
     }
-    // The water closes the gap the fill left around the body, then calms down.
-    let speeds = stats_column(dir.path(), "max_speed");
-    let late = speeds[speeds.len() / 2..]
-        .iter()
-        .fold(0.0, |m: f64, s| m.max(*s));
-    let early = speeds[..speeds.len() / 10]
-        .iter()
-        .fold(0.0, |m: f64, s| m.max(*s));
-    eprintln!("max speed early {early}, late {late}");
-    // Measured: 0.023 m/s over the first tenth, 5.3e-3 m/s over the second half (2026-12-06).
+    // The body's particles are the ghosts of a wall: the water's hydrostatic pressure runs into
+    // it exactly and the water beside it stays still. Measured: 2.9e-5 m/s over the first tenth,
+    // 1.3e-4 m/s at most over 0.5 s (2026-12-07; the water about the lattice's circle settles
+    // to 1.5e-3 m/s by 6 s and stays there to 10 s). Before the ghosts, 0.023 m/s.
+    let fastest = stats_column(dir.path(), "max_speed")
+        .into_iter()
+        .fold(0.0, f64::max);
+    eprintln!("the water's largest speed {fastest} m/s");
     assert!(
-        late < early && late < 0.01,
-        "the water around a fixed body speeds up or keeps moving: {early} → {late} m/s"
+        fastest < 1e-3,
+        "the water around a fixed body moved at {fastest} m/s"
     );
 }
 

@@ -140,6 +140,7 @@ impl<const D: usize> InteriorRows<D> {
             gravity: [0.0; D],
             ghost_force: BodyForce::Uniform([0.0; D]),
             interfaces: None,
+            ghosts: None,
         }
     }
 }

@@ -176,6 +176,16 @@ impl RigidBody {
         }
     }
 
+    /// Whether the body's motion over the step from t is given, fixed or prescribed (held, and
+    /// not resting): the fluid then sees its particles as the ghosts of a moving wall
+    /// (`ppe::Role::Ghost`).
+    pub fn is_driven(&self, t: f64) -> bool {
+        matches!(
+            self.motion_at(t),
+            BodyMotion::Fixed | BodyMotion::Prescribed(_)
+        )
+    }
+
     /// The pose and velocities a held body (`is_held`) has at t + dt (None for a body that
     /// moves freely over the step): where its motion takes it, or for a resting body where it
     /// is, at rest.

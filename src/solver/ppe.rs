@@ -14,6 +14,8 @@
 //!   pressure ρ g dx/2 short everywhere below.) The row couples the particle to its fluid
 //!   neighbours through the corrected gradient; the walls' ghosts are its right-hand side.
 //! * splash rows (particles too isolated for a gradient): P_i = 0.
+//! * ghost rows (a fixed or prescribed body's particles with fluid in reach): the fluid's
+//!   pressure continued into the body, a wall moving with it (`Role::Ghost`).
 //!
 //! The walls have no row: their pressures for output are computed after the solve from their
 //! fluid neighbours (`ghosts::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
@@ -49,6 +51,10 @@ pub enum Role {
     /// The one fluid particle pinned to P = 0 where the fluid has no free surface at all (a
     /// closed or periodic box), whose PPE fixes the pressure only up to a constant.
     Reference,
+    /// A fixed or prescribed body's particle with fluid in reach: the ghost of the fluid's pressure beside
+    /// it, P_b = Σ_f W_bf (P_f + ρ0_f (f_f − a_b)·r_bf) / Σ_f W_bf (`ghost_source`), so that
+    /// the fluid sees a wall moving at the body's acceleration a_b (Adami, Hu & Adams 2012).
+    Ghost,
 }
 
 impl Role {
@@ -63,7 +69,7 @@ impl Role {
         match self {
             Role::Surface => 1,
             Role::Splash => 2,
-            Role::Interior | Role::Reference => 0,
+            Role::Interior | Role::Reference | Role::Ghost => 0,
         }
     }
 
@@ -105,6 +111,15 @@ pub fn role<const D: usize>(
     } else {
         Role::Interior
     }
+}
+
+/// Whether a fluid particle (not a body's) lies within the kernel support of particle i.
+pub fn has_fluid_in_reach<const D: usize>(nb: &Neighbours<D>, p: &Particles<D>, i: usize) -> bool {
+    let mut found = false;
+    nb.for_each_of(i, &[Kind::Fluid], |j, _, _| {
+        found = found || p.kind[j] == Kind::Fluid
+    });
+    found
 }
 
 /// If the fluid has no free surface at all (a full closed or periodic box) the PPE is singular;
@@ -195,7 +210,7 @@ pub fn row_vector<const D: usize>(
                 None => c,
             }
         }
-        Role::Surface | Role::Splash | Role::Reference => [0.0; D],
+        Role::Surface | Role::Splash | Role::Reference | Role::Ghost => [0.0; D],
     }
 }
 
@@ -310,12 +325,16 @@ pub fn projection_source<const D: usize>(
     let g = op.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     b.resize(op.roles.len(), 0.0);
     fill(b, |i| match op.roles[i] {
-        Role::Interior => divergence_source(nb, p, corrections.of(i), u_star, dt, carried_dt, i),
+        Role::Interior => {
+            let ghosts = op.ghosts.map(|g| g.is_ghost);
+            divergence_source(nb, p, corrections.of(i), ghosts, u_star, dt, carried_dt, i)
+        }
         Role::Surface if op.row_vectors[i] != [0.0; D] => op.surface_wall_source(i),
         Role::Surface => {
             let up = op.gravity.map(|x| if g > 0.0 { -x / g } else { 0.0 });
             p.rest_density[i] * g * surface_depth(nb, p, up, spacing, dt, i)
         }
+        Role::Ghost => op.ghost_source(i),
         Role::Splash | Role::Reference => 0.0,
     });
     balance_compression(op.roles, closed, sealed, b);
@@ -363,7 +382,7 @@ pub fn density_source<const D: usize>(
             };
             -density_rate * deviation / dt
         }
-        Role::Surface | Role::Splash | Role::Reference => 0.0,
+        Role::Surface | Role::Splash | Role::Reference | Role::Ghost => 0.0,
     });
     balance_compression(op.roles, closed, sealed, b);
 }
@@ -452,10 +471,12 @@ fn net_compression(
 /// nothing over a sliver; on every step cut to land on a frame that braked the Taylor–Green
 /// vortex by 0.6% of its kinetic energy in 0.3 L/U, so those take it out over Δt. What the step itself adds to u* (its forces; a held body's hold) is taken out over
 /// Δt.
+#[allow(clippy::too_many_arguments)]
 fn divergence_source<const D: usize>(
     nb: &Neighbours<D>,
     p: &Particles<D>,
     l: &Correction<D>,
+    ghosts: Option<&[f64]>,
     u_star: &[Vec<f64>; D],
     dt: f64,
     carried_dt: f64,
@@ -469,7 +490,17 @@ fn divergence_source<const D: usize>(
     let velocity = |field: &[Vec<f64>; D], u_own: [f64; D], l: &Lanes<D>| -> [F64s; D] {
         match l.kind {
             Kind::Wall => ghost_velocity(p, l, u_own, u_i),
-            Kind::Fluid | Kind::Body => std::array::from_fn(|d| l.load(&field[d])),
+            Kind::Fluid | Kind::Body => {
+                let own: [F64s; D] = std::array::from_fn(|d| l.load(&field[d]));
+                match ghosts {
+                    Some(ghosts) => {
+                        let ghost = l.load(ghosts).simd_ne(F64s::ZERO);
+                        let held = held_body_velocity(p, l, u_own, u_i);
+                        std::array::from_fn(|d| ghost.select(held[d], own[d]))
+                    }
+                    None => own,
+                }
+            }
         }
     };
     // ∇·u* = trace of the corrected velocity gradient, Eq. (22) with Eq. (24)–(25).
@@ -492,6 +523,24 @@ fn divergence_source<const D: usize>(
         (grad_u, trace(&grad_u))
     };
     -p.rest_density[i] / dt * (div + 0.5 * dt * divergence_rate_in_drift(&grad_u))
+}
+
+/// The velocities the ghost particles b of fixed and prescribed bodies in lanes `l` take in the divergence of
+/// fluid particle i, as the walls' (`ghosts::ghost_velocity`) with the body's normal n_b and
+/// velocity u_b: u_own − n_b n_b·(u_i − u_b), the fluid's own velocity with its normal
+/// velocity relative to the body taken out.
+#[inline(always)]
+fn held_body_velocity<const D: usize>(
+    p: &Particles<D>,
+    l: &Lanes<D>,
+    u_own: [f64; D],
+    u_i: [f64; D],
+) -> [F64s; D] {
+    let n: [F64s; D] = std::array::from_fn(|d| l.load(&p.normal[d]));
+    let relative = (0..D).fold(F64s::ZERO, |s, d| {
+        n[d].mul_add(F64s::splat(u_i[d]) - l.load(&p.vel[d]), s)
+    });
+    std::array::from_fn(|d| F64s::splat(u_own[d]) - n[d] * relative)
 }
 
 /// The trace of a velocity gradient: the divergence.
@@ -594,6 +643,19 @@ pub struct PressureOperator<'a, const D: usize> {
     /// Where the fluids differ in rest density, each fluid particle's distance to the nearest
     /// interface (`interior_weights`).
     pub interfaces: Option<Field<'a, D>>,
+    /// Where some rows are `Role::Ghost`: 1 at a fluid particle, 0 at a body's (the particles
+    /// a ghost row averages), and the body force of each fluid and body particle (a held
+    /// body's, its acceleration a_b over the step: `step::body_forces`).
+    pub ghosts: Option<GhostRows<'a, D>>,
+}
+
+/// What the ghost rows of fixed and prescribed bodies' particles are made of (`Role::Ghost`).
+#[derive(Clone, Copy)]
+pub struct GhostRows<'a, const D: usize> {
+    pub is_fluid: &'a [f64],
+    /// 1 at a ghost row, 0 elsewhere.
+    pub is_ghost: &'a [f64],
+    pub force: BodyForce<'a, D>,
 }
 
 /// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
@@ -681,8 +743,47 @@ impl<const D: usize> PressureOperator<'_, D> {
                     self.weighted_differences(x, i, |l| self.surface_weights(i, l, l.load(volume)));
                 std::array::from_fn(|k| x[k][i] - d[k])
             }
+            Role::Ghost => self.ghost_rows(x, i),
             Role::Splash | Role::Reference => x.map(|x| x[i]),
         }
+    }
+
+    /// x_b − Σ_f W_bf x_f / Σ_f W_bf of ghost row b for each of the K vectors x, over its fluid
+    /// neighbours (`Role::Ghost`), in one walk.
+    #[inline(always)]
+    fn ghost_rows<const K: usize>(&self, x: [&[f64]; K], b: usize) -> [f64; K] {
+        let is_fluid = self
+            .ghosts
+            .expect("ghost rows have their fluid flags")
+            .is_fluid;
+        let mut weights = Sum::ZERO;
+        let mut sums = [Sum::ZERO; K];
+        self.nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
+            let w = (self.nb.kernel.w_lanes(l.r) & l.mask) * l.load(is_fluid);
+            weights += w;
+            for k in 0..K {
+                sums[k] = sums[k].mul_add(w, l.load(x[k]));
+            }
+        });
+        let total = weights.total();
+        std::array::from_fn(|k| x[k][b] - sums[k].total() / total)
+    }
+
+    /// The right-hand side of ghost row b: Σ_f W_bf ρ0_f (f_f − a_b)·r_bf / Σ_f W_bf, the
+    /// hydrostatic and accelerating part of the fluid's pressure continued to b.
+    fn ghost_source(&self, b: usize) -> f64 {
+        let ghosts = self.ghosts.expect("ghost rows have their fluid flags");
+        let p = self.p;
+        let a_b = ghosts.force.at(b).map(F64s::splat);
+        let (mut weights, mut sum) = (Sum::ZERO, Sum::ZERO);
+        self.nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
+            let w = (self.nb.kernel.w_lanes(l.r) & l.mask) * l.load(ghosts.is_fluid);
+            let f = ghosts.force.lanes(l);
+            let g_r = (0..D).fold(F64s::ZERO, |s, d| (f[d] - a_b[d]).mul_add(l.rij[d], s));
+            weights += w;
+            sum = sum.mul_add(w, l.load(&p.rest_density) * g_r);
+        });
+        sum.total() / weights.total()
     }
 
     /// Σ_j w_ij (x_i − x_j) over row i's fluid neighbours for each of the K vectors x, in one
@@ -762,7 +863,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
                 });
                 1.0 - d.total()
             }
-            Role::Splash | Role::Reference => 1.0,
+            Role::Splash | Role::Reference | Role::Ghost => 1.0,
         })
     }
 }
@@ -779,7 +880,7 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
     fn aggregate(&self, i: usize) -> Option<usize> {
         match self.roles[i] {
             Role::Interior => Some(self.nb.grid().block_of_sorted(i)),
-            Role::Surface | Role::Splash | Role::Reference => None,
+            Role::Surface | Role::Splash | Role::Reference | Role::Ghost => None,
         }
     }
 
@@ -817,7 +918,9 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
             }
             let (w, slot) = (w.to_array(), slot.to_array());
             for (k, w) in w.into_iter().enumerate() {
-                if w == 0.0 {
+                // A ghost follows the water beside it: the coarse level carries a water
+                // particle's correction into its ghosts, and their pair adds nothing.
+                if w == 0.0 || self.roles[l.j0 + k] == Role::Ghost {
                     continue;
                 }
                 row[centre] += w;

@@ -3,13 +3,14 @@
 //! body's particles that plus the body's external force over its mass, so the pressure solve
 //! sees the body accelerate and its added mass is implicit, and the rigid part of the last
 //! step's pressure acceleration less their own, so that the solve starts from a body that moves
-//! as one (`rigidise_free_bodies`); on a fixed or prescribed body's
-//! particles the acceleration that takes each to its rigid velocity at the end of the step,
-//! plus the pressure acceleration the last step's pressure gave it, ∇Pⁿ/ρ0: the corrector
-//! takes the new one off, so the solve leaves the body at its rigid velocity up to the change
-//! of ∇P over a step, and the fluid around it sees a body that is held, not one that yields
-//! to the pressure and is put back each step (which stirs still water around a fixed body).
-//! A body resting on its supports is held so (`bodies::contact`); the body forces on its own
+//! as one (`rigidise_free_bodies`); on a fixed or prescribed body's particles the acceleration
+//! that takes each to its rigid velocity at the end of the step (the solve sees them as the
+//! ghosts of a wall moving so: `ppe::Role::Ghost`). A body resting on its supports
+//! (`bodies::contact`) is fluid in the solve, and its particles take that acceleration plus
+//! the pressure acceleration the last step's pressure gave them, ∇Pⁿ/ρ0: the corrector takes
+//! the new one off, so the solve leaves the body at rest up to the change of ∇P over a step,
+//! and the fluid around it sees a body that is held, not one that yields to the pressure and
+//! is put back each step (which stirs still water around it). The body forces on its own
 //! masses, which its supports must hold with the fluid's force, are summed apart
 //! (`resting_loads`).
 //! The predictor adds f_i (Eq. 5), the wall ghosts carry it (beside a body's particles the
@@ -91,11 +92,15 @@ impl<const D: usize> BodyForces<D> {
                 Some((target, rotation)) => {
                     let arm = bodies.bodies[b].arm(rotation, p.id[i]);
                     let u = rigid_velocity(target.velocity, target.angular_velocity, arm);
+                    let hold: [f64; D] = std::array::from_fn(|d| (u[d] - p.vel[d][i]) / dt);
+                    if bodies.bodies[b].is_driven(time) {
+                        return hold;
+                    }
                     let ghosts = set.ghost_force_of(ambient(i));
                     let grad =
                         pressure_gradient(nb, p, &p.pressure, surface, ghosts, interfaces, i);
                     let rho0 = p.rest_density[i];
-                    std::array::from_fn(|d| (u[d] - p.vel[d][i]) / dt + grad[d] / rho0)
+                    std::array::from_fn(|d| hold[d] + grad[d] / rho0)
                 }
                 None => {
                     let f = ambient(i);
@@ -350,7 +355,7 @@ impl<const D: usize> Stage<D> for BodyForces<D> {
         } else {
             "gravity"
         };
-        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass and the rigid part of the last step's pressure acceleration less their own (A + α × r − a_i, zero net force and moment); on a fixed, prescribed or resting body's the acceleration to its rigid velocity at the step's end plus the last step's ∇P/ρ0, and a resting body's own weight and external force for its supports; beside a body's particles the wall ghosts carry the water's weight, ρ_w f, not the body's")
+        format!("f on each particle for the predictor and the wall ghosts: {frame}; on a free body's particles plus its external force over its mass and the rigid part of the last step's pressure acceleration less their own (A + α × r − a_i, zero net force and moment); on a fixed or prescribed body's the acceleration to its rigid velocity at the step's end (the solve's ghosts of a moving wall); on a resting body's that plus the last step's ∇P/ρ0, and its own weight and external force for its supports; beside a body's particles the wall ghosts carry the water's weight, ρ_w f, not the body's")
     }
 
     fn arrays(&self) -> Vec<ArraySize> {

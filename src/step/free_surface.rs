@@ -12,7 +12,7 @@ use super::{Stage, StepSettings};
 use crate::effects::les;
 use crate::math::memory::ArraySize;
 use crate::neighbours::Neighbours;
-use crate::particles::Particles;
+use crate::particles::{Kind, Particles};
 use crate::scene::Effects;
 use crate::solver::ppe::{self, LaplacianTruncation, Role};
 use crate::sph::free_surface::Support;
@@ -80,13 +80,16 @@ impl<const D: usize> FreeSurface<D> {
     }
 
     /// Classifies the `nf` fluid particles, inverting L'_i from the same moments (once per step
-    /// for every operator after it); `fluids_differ`: the scene's fluids differ in rest density.
+    /// for every operator after it); `fluids_differ`: the scene's fluids differ in rest density;
+    /// `driven(b)`: body b's motion over the step is given (fixed or prescribed), so that its
+    /// particles with fluid in reach are the fluid's ghosts (`ppe::Role::Ghost`).
     pub fn run(
         &mut self,
         nb: &Neighbours<D>,
         p: &Particles<D>,
         set: &StepSettings<D>,
         fluids_differ: bool,
+        driven: impl Fn(usize) -> bool + Sync,
         nf: usize,
     ) {
         let n = nf;
@@ -139,6 +142,16 @@ impl<const D: usize> FreeSurface<D> {
                 }
                 if let (Some(rate), Some(found)) = (strain_rate, s.strain_rate) {
                     *rate = found;
+                }
+            });
+        self.roles
+            .par_iter_mut()
+            .zip(&mut self.row_vectors)
+            .enumerate()
+            .filter(|(i, _)| p.kind[*i] == Kind::Body && driven(p.fluid[*i] as usize))
+            .for_each(|(i, (role, row_vector))| {
+                if ppe::has_fluid_in_reach(nb, p, i) {
+                    (*role, *row_vector) = (Role::Ghost, [0.0; D]);
                 }
             });
         self.reference = ppe::pin_reference(p, set.gravity, &mut self.roles);
@@ -434,7 +447,7 @@ mod tests {
                 kernel_correction: corrected,
             };
             let mut stage = FreeSurface::new(&effects);
-            stage.run(&nb, &p, &settings(effects), false, nf);
+            stage.run(&nb, &p, &settings(effects), false, |_| false, nf);
             let s = stage.output();
             for i in (0..nf).filter(|&i| s.roles[i] == Role::Interior) {
                 let expected = expected_row_vector(&nb, &p, i, corrected);
@@ -468,7 +481,7 @@ mod tests {
         };
         let set = settings(effects);
         let mut stage = FreeSurface::new(&effects);
-        stage.run(&nb, &p, &set, false, nf);
+        stage.run(&nb, &p, &set, false, |_| false, nf);
         let (s, rates) = (stage.output(), stage.strain_rates().unwrap());
         let mut kernel_correction = super::super::kernel_correction::KernelCorrection::default();
         let corrections =

@@ -357,7 +357,9 @@ impl<const D: usize> Step<D> {
                 laps.lap(interface_distance::NAME);
             }
             let interfaces = self.interface_distance.as_ref().map(|s| s.field());
-            self.free_surface.run(&nb, p, set, interfaces.is_some(), nf);
+            let driven = |b: usize| bodies.bodies[b].is_driven(time);
+            self.free_surface
+                .run(&nb, p, set, interfaces.is_some(), driven, nf);
             // Into the particles: ρ.
             p.density[..nf].copy_from_slice(self.free_surface.density());
             laps.lap(free_surface::NAME);

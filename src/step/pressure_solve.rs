@@ -15,11 +15,11 @@ use crate::boundary::ghosts::BodyForce;
 use crate::math::memory::ArraySize;
 use crate::math::reduce::{self, fill};
 use crate::neighbours::Neighbours;
-use crate::particles::Particles;
+use crate::particles::{Kind, Particles};
 use crate::scene::GhostPressure;
 use crate::solver::krylov::{BiCgStab, Preconditioner, SolveInfo, SolverError, SolverParams};
 use crate::solver::multigrid::Multigrid;
-use crate::solver::ppe::{self, PressureOperator, Role};
+use crate::solver::ppe::{self, GhostRows, PressureOperator, Role};
 use crate::sph::interface;
 use crate::sph::Corrections;
 use rayon::prelude::*;
@@ -36,6 +36,11 @@ const DENSITY_TOLERANCE: f64 = 1e-2;
 pub struct PressureSolve<const D: usize> {
     /// V_j = m_j/ρ0_j of fluid particles (the unknowns of the PPE).
     fluid_volume: Vec<f64>,
+    /// 1 at a fluid particle and 0 at a body's, where some rows are held bodies' ghosts
+    /// (`ppe::GhostRows`); empty otherwise.
+    is_fluid: Vec<f64>,
+    /// 1 at a ghost row, 0 elsewhere, with `is_fluid`.
+    is_ghost: Vec<f64>,
     rhs: Vec<f64>,
     /// The projection's solution (before the cavitation clip that the particles' pressure takes).
     pressure: Vec<f64>,
@@ -88,6 +93,8 @@ impl<const D: usize> PressureSolve<D> {
     pub fn new(density_correction: bool) -> Self {
         Self {
             fluid_volume: Vec::new(),
+            is_fluid: Vec::new(),
+            is_ghost: Vec::new(),
             rhs: Vec::new(),
             pressure: Vec::new(),
             bicgstab: BiCgStab::default(),
@@ -119,6 +126,8 @@ impl<const D: usize> PressureSolve<D> {
         let nf = surface.full_support().len();
         let Self {
             fluid_volume,
+            is_fluid,
+            is_ghost,
             rhs,
             pressure,
             bicgstab,
@@ -133,6 +142,18 @@ impl<const D: usize> PressureSolve<D> {
             }
             _ => [0.0; D],
         });
+        is_fluid.clear();
+        is_ghost.clear();
+        let roles = surface.output().roles;
+        if roles.contains(&Role::Ghost) {
+            is_fluid.extend((0..nf).map(|i| f64::from(p.kind[i] == Kind::Fluid)));
+            is_ghost.extend(roles.iter().map(|&r| f64::from(r == Role::Ghost)));
+        }
+        let ghosts = (!is_fluid.is_empty()).then_some(GhostRows {
+            is_fluid,
+            is_ghost,
+            force,
+        });
         with_operator(
             fluid_volume,
             multigrid,
@@ -142,6 +163,7 @@ impl<const D: usize> PressureSolve<D> {
             surface,
             interfaces,
             ghost,
+            ghosts,
             |op, mg, sealed, s| {
                 if let Some(probe) = probe {
                     probe(op);
@@ -163,7 +185,7 @@ impl<const D: usize> PressureSolve<D> {
                 // In a closed box the last pressure is shifted to the new reference's level.
                 let level = reference.map_or(0.0, |r| p.pressure[r]);
                 fill(pressure, |i| match roles[i] {
-                    Role::Interior | Role::Surface => p.pressure[i] - level,
+                    Role::Interior | Role::Surface | Role::Ghost => p.pressure[i] - level,
                     Role::Splash | Role::Reference => 0.0,
                 });
                 let info = match density {
@@ -212,6 +234,7 @@ fn with_operator<const D: usize, R>(
     surface: &mut FreeSurface<D>,
     interfaces: Option<interface::Field<D>>,
     ghost: Option<&[Vec<f64>; D]>,
+    ghosts: Option<GhostRows<D>>,
     solve: impl FnOnce(
         &PressureOperator<D>,
         &mut Multigrid<D>,
@@ -233,6 +256,7 @@ fn with_operator<const D: usize, R>(
             gravity: set.gravity,
             ghost_force: set.ghost_force(ghost),
             interfaces,
+            ghosts,
         };
         multigrid.setup(&op)?;
         let unanchored = multigrid.unanchored_regions();
@@ -285,6 +309,8 @@ impl<const D: usize> Stage<D> for PressureSolve<D> {
     fn arrays(&self) -> Vec<ArraySize> {
         let mut arrays = vec![
             ArraySize::of("fluid volume", &self.fluid_volume),
+            ArraySize::sparse("fluid flags of the ghost rows", &self.is_fluid),
+            ArraySize::sparse("ghost flags", &self.is_ghost),
             ArraySize::of("right-hand side", &self.rhs),
             ArraySize::of("pressure", &self.pressure),
         ];
