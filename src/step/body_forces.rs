@@ -53,7 +53,7 @@ impl<const D: usize> BodyForces<D> {
 
     /// f_i of the `nf` fluid and body particles over the step of `dt` from `time` (`force`), and
     /// the body force their wall ghosts carry (`ghost`); the last step's pressure gradient at a
-    /// held body's particles is taken with `surface`'s roles and corrections across
+    /// resting or free body's particles is taken with `surface`'s roles and corrections across
     /// `interfaces`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
