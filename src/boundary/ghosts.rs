@@ -141,6 +141,24 @@ pub fn ghost_velocity<const D: usize>(
     std::array::from_fn(|d| F64s::splat(u_i[d]) - across[d])
 }
 
+/// The velocities the ghost particles b of fixed and prescribed bodies in lanes `l` take in
+/// the divergence of fluid particle i (`ppe::Role::Ghost`), as the walls' (`ghost_velocity`)
+/// with the body's normal n_b and velocity u_b: u_own − n_b n_b·(u_i − u_b), the fluid's own
+/// velocity with its normal velocity relative to the body taken out.
+#[inline(always)]
+pub fn body_ghost_velocity<const D: usize>(
+    p: &Particles<D>,
+    l: &Lanes<D>,
+    u_own: [f64; D],
+    u_i: [f64; D],
+) -> [F64s; D] {
+    let n: [F64s; D] = std::array::from_fn(|d| l.load(&p.normal[d]));
+    let relative = (0..D).fold(F64s::ZERO, |s, d| {
+        n[d].mul_add(F64s::splat(u_i[d]) - l.load(&p.vel[d]), s)
+    });
+    std::array::from_fn(|d| F64s::splat(u_own[d]) - n[d] * relative)
+}
+
 /// u_i − u_b of the no-slip wall particles b in lanes `l` in the viscous term of fluid particle
 /// i, after Morris, Fox & Zhu (1997): the wall particle takes u_b = −(d_b/d_i) u_i relative to
 /// the wall (d the distances to the wall face, `d_i` fluid particle i's), which puts the wall's

@@ -21,7 +21,9 @@
 //! fluid neighbours (`ghosts::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
 //! first in the sorted order).
 
-use crate::boundary::ghosts::{ghost_pressure_difference, ghost_velocity, BodyForce};
+use crate::boundary::ghosts::{
+    body_ghost_velocity, ghost_pressure_difference, ghost_velocity, BodyForce,
+};
 use crate::math::lanes::{F64s, Sum};
 use crate::math::reduce::{fill, fill_pair};
 use crate::neighbours::Lanes;
@@ -495,7 +497,7 @@ fn divergence_source<const D: usize>(
                 match ghosts {
                     Some(ghosts) => {
                         let ghost = l.load(ghosts).simd_ne(F64s::ZERO);
-                        let held = held_body_velocity(p, l, u_own, u_i);
+                        let held = body_ghost_velocity(p, l, u_own, u_i);
                         std::array::from_fn(|d| ghost.select(held[d], own[d]))
                     }
                     None => own,
@@ -523,24 +525,6 @@ fn divergence_source<const D: usize>(
         (grad_u, trace(&grad_u))
     };
     -p.rest_density[i] / dt * (div + 0.5 * dt * divergence_rate_in_drift(&grad_u))
-}
-
-/// The velocities the ghost particles b of fixed and prescribed bodies in lanes `l` take in the divergence of
-/// fluid particle i, as the walls' (`ghosts::ghost_velocity`) with the body's normal n_b and
-/// velocity u_b: u_own − n_b n_b·(u_i − u_b), the fluid's own velocity with its normal
-/// velocity relative to the body taken out.
-#[inline(always)]
-fn held_body_velocity<const D: usize>(
-    p: &Particles<D>,
-    l: &Lanes<D>,
-    u_own: [f64; D],
-    u_i: [f64; D],
-) -> [F64s; D] {
-    let n: [F64s; D] = std::array::from_fn(|d| l.load(&p.normal[d]));
-    let relative = (0..D).fold(F64s::ZERO, |s, d| {
-        n[d].mul_add(F64s::splat(u_i[d]) - l.load(&p.vel[d]), s)
-    });
-    std::array::from_fn(|d| F64s::splat(u_own[d]) - n[d] * relative)
 }
 
 /// The trace of a velocity gradient: the divergence.
@@ -658,6 +642,15 @@ pub struct GhostRows<'a, const D: usize> {
     pub force: BodyForce<'a, D>,
 }
 
+impl<const D: usize> GhostRows<'_, D> {
+    /// W_bf of a ghost row's neighbours in lanes `l`: the kernel at the fluid particles, zero
+    /// at the bodies' (the particles a ghost averages).
+    #[inline(always)]
+    fn weights(&self, nb: &Neighbours<D>, l: &Lanes<D>) -> F64s {
+        (nb.kernel.w_lanes(l.r) & l.mask) * l.load(self.is_fluid)
+    }
+}
+
 /// The constants of interior row i in lanes: −2/ρ_i of Eq. (27) and the row vector ĉ_i.
 struct Row<const D: usize> {
     scale: F64s,
@@ -752,14 +745,11 @@ impl<const D: usize> PressureOperator<'_, D> {
     /// neighbours (`Role::Ghost`), in one walk.
     #[inline(always)]
     fn ghost_rows<const K: usize>(&self, x: [&[f64]; K], b: usize) -> [f64; K] {
-        let is_fluid = self
-            .ghosts
-            .expect("ghost rows have their fluid flags")
-            .is_fluid;
+        let ghosts = self.ghosts.expect("ghost rows have their fluid flags");
         let mut weights = Sum::ZERO;
         let mut sums = [Sum::ZERO; K];
         self.nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
-            let w = (self.nb.kernel.w_lanes(l.r) & l.mask) * l.load(is_fluid);
+            let w = ghosts.weights(self.nb, l);
             weights += w;
             for k in 0..K {
                 sums[k] = sums[k].mul_add(w, l.load(x[k]));
@@ -777,7 +767,7 @@ impl<const D: usize> PressureOperator<'_, D> {
         let a_b = ghosts.force.at(b).map(F64s::splat);
         let (mut weights, mut sum) = (Sum::ZERO, Sum::ZERO);
         self.nb.for_each_lanes_of(b, &[Kind::Fluid], |l| {
-            let w = (self.nb.kernel.w_lanes(l.r) & l.mask) * l.load(ghosts.is_fluid);
+            let w = ghosts.weights(self.nb, l);
             let f = ghosts.force.lanes(l);
             let g_r = (0..D).fold(F64s::ZERO, |s, d| (f[d] - a_b[d]).mul_add(l.rij[d], s));
             weights += w;

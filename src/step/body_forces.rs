@@ -22,7 +22,7 @@ use super::corrector::pressure_gradient;
 use super::free_surface::Surface;
 use super::hydrostatic_split::surface_excess;
 use super::{Stage, StepSettings};
-use crate::bodies::{rigid_velocity, Bodies, RigidTarget};
+use crate::bodies::{rigid_velocity, Bodies};
 use crate::boundary::moving_frame::{FrameForce, MovingFrame};
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_vector;
@@ -111,9 +111,7 @@ impl<const D: usize> BodyForces<D> {
         if bodies.is_empty() {
             return;
         }
-        self.rigidise_free_bodies(
-            nb, p, bodies, set, surface, interfaces, &targets, &ambient, nf,
-        );
+        self.rigidise_free_bodies(nb, p, bodies, set, surface, interfaces, time, &ambient, nf);
         for a in &mut self.ghost {
             a.resize(nf, 0.0);
         }
@@ -150,12 +148,13 @@ impl<const D: usize> BodyForces<D> {
         set: &StepSettings<D>,
         surface: &Surface<D>,
         interfaces: Option<interface::Field<D>>,
-        targets: &[Option<(RigidTarget, Mat3)>],
+        time: f64,
         ambient: &(impl Fn(usize) -> [f64; D] + Sync),
         nf: usize,
     ) {
+        let free = |i: usize| !bodies.bodies[p.fluid[i] as usize].is_held(time);
         let members: Vec<usize> = (0..nf)
-            .filter(|&i| p.kind[i] == Kind::Body && targets[p.fluid[i] as usize].is_none())
+            .filter(|&i| p.kind[i] == Kind::Body && free(i))
             .collect();
         if members.is_empty() {
             return;
