@@ -486,8 +486,8 @@ motion = "fixed"
         assert!(r[..2] == rows[0].1[..2], "t = {t}: moved to {:?}", &r[..2]);
     }
     // The body's particles are the ghosts of a wall: the water's hydrostatic pressure runs into
-    // it exactly and the water beside it stays still. Measured: 2.9e-5 m/s over the first tenth,
-    // 1.3e-4 m/s at most over 0.5 s (2026-12-07; the water about the lattice's circle settles
+    // it exactly and the water beside it stays still. Measured: 1.5e-4 m/s at most over 0.5 s
+    // (2026-12-07; the water about the lattice's circle settles
     // to 1.5e-3 m/s by 6 s and stays there to 10 s). Before the ghosts, 0.023 m/s.
     let fastest = stats_column(dir.path(), "max_speed")
         .into_iter()

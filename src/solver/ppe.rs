@@ -15,7 +15,10 @@
 //!   neighbours through the corrected gradient; the walls' ghosts are its right-hand side.
 //! * splash rows (particles too isolated for a gradient): P_i = 0.
 //! * ghost rows (a fixed or prescribed body's particles with fluid in reach): the fluid's
-//!   pressure continued into the body, a wall moving with it (`Role::Ghost`).
+//!   pressure continued into the body, a wall moving with it (`Role::Ghost`). The fluid rows
+//!   see these ghosts as the walls' are seen, known differences in their right-hand side
+//!   (`PressureOperator::ghost_differences`), so the fluid block is the operator of a scene
+//!   without the body and the ghost rows follow from it.
 //!
 //! The walls have no row: their pressures for output are computed after the solve from their
 //! fluid neighbours (`ghosts::Ghosts::wall_pressure`). Row i is fluid particle i (the fluid comes
@@ -657,6 +660,9 @@ struct Row<const D: usize> {
     c: [F64s; D],
     /// ρ0_i and i's distance to the nearest interface.
     density: Side<D>,
+    /// Row i is a fluid particle's in a scene with ghost rows: its held-body neighbours are
+    /// known differences (`GhostRows::beside_fluid`), not unknowns.
+    fluid: bool,
 }
 
 impl<const D: usize> PressureOperator<'_, D> {
@@ -665,6 +671,23 @@ impl<const D: usize> PressureOperator<'_, D> {
             scale: F64s::splat(-2.0 / self.p.rest_density[i]),
             c: self.row_vectors[i].map(F64s::splat),
             density: Side::of(self.p, self.interfaces, i),
+            fluid: self.is_fluid_row(i),
+        }
+    }
+
+    /// Whether row i is a fluid particle's in a scene with ghost rows (`GhostRows`).
+    fn is_fluid_row(&self, i: usize) -> bool {
+        self.ghosts.is_some_and(|g| g.is_fluid[i] == 1.0)
+    }
+
+    /// The weights `w` of a row's neighbours in lanes `l` without its ghosts' where the row is
+    /// a fluid particle's (`fluid`): their pressures are its own continued, known differences
+    /// in the right-hand side (`ghost_differences`).
+    #[inline(always)]
+    fn unknown_weights(&self, fluid: bool, l: &Lanes<D>, w: F64s) -> F64s {
+        match self.ghosts {
+            Some(g) if fluid => l.load(g.is_ghost).simd_ne(F64s::ZERO).select(F64s::ZERO, w),
+            _ => w,
         }
     }
 
@@ -700,14 +723,49 @@ impl<const D: usize> PressureOperator<'_, D> {
         weight.fast_max(F64s::ZERO) & l.mask
     }
 
-    /// The weights of interior row i with its fluid neighbours `l`.
+    /// The weights of interior row i with its fluid neighbours `l`, the unknowns among them.
     #[inline(always)]
     fn fluid_weights(&self, row: &Row<D>, l: &Lanes<D>) -> F64s {
-        self.interior_weights(row, l, l.load(self.fluid_volume))
+        let w = self.interior_weights(row, l, l.load(self.fluid_volume));
+        self.unknown_weights(row.fluid, l, w)
+    }
+
+    /// The weights of free-surface row i with its fluid neighbours `l`, the unknowns among
+    /// them.
+    #[inline(always)]
+    fn surface_unknown_weights(&self, i: usize, l: &Lanes<D>) -> F64s {
+        let w = self.surface_weights(i, l, l.load(self.fluid_volume));
+        self.unknown_weights(self.is_fluid_row(i), l, w)
+    }
+
+    /// Σ_b w_ib (P_b − P_i) over the ghosts b of fluid particle i's row, `weights` their w_ib:
+    /// P_b − P_i = −ρ0_i (f_i − a_b)·r_ib, fluid particle i's pressure continued into the body
+    /// under the Neumann condition of a wall accelerating at a_b, as the walls' (`boundary::ghosts`)
+    /// but along every direction, as the ghost rows' own average takes it (`ghost_source`).
+    /// The fluid rows thus couple fluid unknowns only, and the operator keeps the symmetry and
+    /// the multigrid's coarse levels of a scene without held bodies; the ghost rows, which
+    /// depend on the fluid and nothing depends on, give the body's pressure.
+    fn ghost_differences(&self, i: usize, weights: impl Fn(&Lanes<D>) -> F64s) -> f64 {
+        let Some(g) = self.ghosts.filter(|_| self.is_fluid_row(i)) else {
+            return 0.0;
+        };
+        let f_i = g.force.at(i).map(F64s::splat);
+        let rho = F64s::splat(-self.p.rest_density[i]);
+        let mut b = Sum::ZERO;
+        self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
+            let ghost = l.load(g.is_ghost);
+            if ghost.simd_ne(F64s::ZERO).to_bitmask() == 0 {
+                return;
+            }
+            let a_b = g.force.lanes(l);
+            let g_r = (0..D).fold(F64s::ZERO, |s, d| (f_i[d] - a_b[d]).mul_add(l.rij[d], s));
+            b = b.mul_add(weights(l) * ghost, rho * g_r);
+        });
+        b.total()
     }
 
     /// The wall part of the right-hand side of interior row i: the Neumann ghosts' known
-    /// differences.
+    /// differences, the walls' and the held bodies' (`ghost_differences`).
     fn wall_source(&self, i: usize) -> f64 {
         let (p, row) = (self.p, self.row_constants(i));
         let mut b = Sum::ZERO;
@@ -716,7 +774,8 @@ impl<const D: usize> PressureOperator<'_, D> {
             let w = self.interior_weights(&row, l, volume);
             b += w * ghost_pressure_difference(p, self.ghost_force.at(i), i, l);
         });
-        b.total()
+        let volume = self.fluid_volume;
+        b.total() + self.ghost_differences(i, |l| self.interior_weights(&row, l, l.load(volume)))
     }
 
     /// (A x)_i for each of the K vectors x, in one walk of row i's neighbours: the interior
@@ -731,9 +790,7 @@ impl<const D: usize> PressureOperator<'_, D> {
             }
             Role::Surface => {
                 // P_i + Σ_j w_ij (P_j − P_i).
-                let volume = self.fluid_volume;
-                let d =
-                    self.weighted_differences(x, i, |l| self.surface_weights(i, l, l.load(volume)));
+                let d = self.weighted_differences(x, i, |l| self.surface_unknown_weights(i, l));
                 std::array::from_fn(|k| x[k][i] - d[k])
             }
             Role::Ghost => self.ghost_rows(x, i),
@@ -808,8 +865,8 @@ impl<const D: usize> PressureOperator<'_, D> {
         (volume * radial.k * radial.r2_eta2 * v_r) & l.mask
     }
 
-    /// The right-hand side of free-surface row i: the walls' known ghost differences,
-    /// −Σ_b V_b (v_i·∇W_ib)(P_b − P_i).
+    /// The right-hand side of free-surface row i: the known ghost differences of the walls and
+    /// the held bodies, −Σ_b V_b (v_i·∇W_ib)(P_b − P_i).
     fn surface_wall_source(&self, i: usize) -> f64 {
         let p = self.p;
         let mut b = Sum::ZERO;
@@ -818,7 +875,8 @@ impl<const D: usize> PressureOperator<'_, D> {
             let w = self.surface_weights(i, l, volume);
             b += w * ghost_pressure_difference(p, self.ghost_force.at(i), i, l);
         });
-        -b.total()
+        let volume = self.fluid_volume;
+        -b.total() - self.ghost_differences(i, |l| self.surface_weights(i, l, l.load(volume)))
     }
 }
 
@@ -849,7 +907,7 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
             Role::Surface => {
                 let mut d = Sum::ZERO;
                 self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-                    d += self.surface_weights(i, l, l.load(self.fluid_volume))
+                    d += self.surface_unknown_weights(i, l)
                 });
                 1.0 - d.total()
             }
