@@ -60,7 +60,7 @@ use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
 use crate::scene::{Effects, GhostPressure};
 use crate::solver::krylov::{SolveInfo, SolverError, SolverParams};
-use crate::solver::ppe::PressureOperator;
+use crate::solver::ppe::{PressureOperator, Role};
 use crate::sph::interface::Interfaces;
 use crate::sph::Corrections;
 use std::time::Instant;
@@ -438,7 +438,9 @@ impl<const D: usize> Step<D> {
             let clip = surface.reference.is_none();
             let solved = self.pressure_solve.pressure();
             // Into the particles: P (without tension where the fluid has a free surface), roles.
-            fill(&mut p.pressure[..nf], |i| cavitation(clip, solved[i]));
+            fill(&mut p.pressure[..nf], |i| {
+                cavitation(clip, surface.roles[i], solved[i])
+            });
             fill(&mut p.free_surface[..nf], |i| surface.roles[i].code());
             laps.lap(pressure_solve::NAME);
             let density = self.density_correction.as_mut().map(|stage| {
@@ -520,7 +522,13 @@ impl<const D: usize> Step<D> {
                     );
                     // Into the particles: u and P at the shifted positions.
                     copy_vector(velocity, &mut p.vel);
-                    shifting::carry_pressure(&mut p.pressure[..nf], grad_p, shift, clip);
+                    shifting::carry_pressure(
+                        &mut p.pressure[..nf],
+                        grad_p,
+                        shift,
+                        clip,
+                        surface.roles,
+                    );
                     laps.lap(shifting::NAME);
                     Some(shift)
                 }
@@ -596,12 +604,17 @@ impl<'a> Laps<'a> {
     }
 }
 
-/// The pressure the fluid takes: with a free surface the pressure is absolute (zero at the
-/// surface) and the water cannot hold a tension, so negative pressures are cut to zero; in a
-/// closed box (`clip` false) only differences count and P is kept as solved.
+/// The pressure a particle of `role` takes: with a free surface the pressure is absolute (zero
+/// at the surface) and the water cannot hold a tension, so negative pressures are cut to zero; in
+/// a closed box (`clip` false) only differences count and P is kept as solved. A held body's
+/// ghost (`Role::Ghost`) is not water: it continues the water's pressure into the body, negative
+/// above the waterline, and keeps it. Clipped there, the ghosts beside the water's surface held
+/// more than the water's pressure continued, and pushed the water at the contact line off the
+/// body every step: a box held through the surface of still water stirred it to 0.12 m/s within
+/// 1 s and ever more after (docs/bodies.md, "Fixed and prescribed bodies").
 #[inline]
-fn cavitation(clip: bool, pressure: f64) -> f64 {
-    if clip {
+fn cavitation(clip: bool, role: Role, pressure: f64) -> f64 {
+    if clip && role != Role::Ghost {
         pressure.max(0.0)
     } else {
         pressure

@@ -105,16 +105,21 @@ impl<const D: usize> Shifting<D> {
 
 /// The fluid pressures carried to the shifted positions by Eq. (9), P += ∇Pⁿ⁺¹·δr, with ∇Pⁿ⁺¹
 /// at rⁿ as the corrector left it (the walls' pressures for a frame do not enter it); clipped
-/// for cavitation as the solve's (`clip`).
+/// for cavitation as the solve's (`clip`, `roles`).
 pub fn carry_pressure<const D: usize>(
     pressure: &mut [f64],
     grad_p: &[Vec<f64>; D],
     shift: &[Vec<f64>; D],
     clip: bool,
+    roles: &[Role],
 ) {
     pressure.par_iter_mut().enumerate().for_each(|(i, p)| {
         let (g, dr) = (vector(grad_p, i), vector(shift, i));
-        *p = cavitation(clip, *p + (0..D).map(|d| g[d] * dr[d]).sum::<f64>());
+        *p = cavitation(
+            clip,
+            roles[i],
+            *p + (0..D).map(|d| g[d] * dr[d]).sum::<f64>(),
+        );
     });
 }
 
