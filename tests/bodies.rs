@@ -461,6 +461,15 @@ fn a_cylinder_oscillated_in_still_water_follows_its_trajectory_and_feels_its_add
     );
 }
 
+/// The water's largest speed [m/s] over the steps of the run in `out`.
+fn largest_speed(out: &Path) -> f64 {
+    let fastest = stats_column(out, "max_speed")
+        .into_iter()
+        .fold(0.0, f64::max);
+    eprintln!("the water's largest speed {fastest} m/s");
+    fastest
+}
+
 #[test]
 fn a_fixed_body_in_still_water_feels_its_buoyancy_and_leaves_the_water_still() {
     let dir = TempDir::new("bodies-fixed");
@@ -489,10 +498,7 @@ motion = "fixed"
     // it exactly and the water beside it stays still. Measured: 1.5e-4 m/s at most over 0.5 s
     // (2026-12-07; the water about the lattice's circle settles
     // to 1.5e-3 m/s by 6 s and stays there to 10 s). Before the ghosts, 0.023 m/s.
-    let fastest = stats_column(dir.path(), "max_speed")
-        .into_iter()
-        .fold(0.0, f64::max);
-    eprintln!("the water's largest speed {fastest} m/s");
+    let fastest = largest_speed(dir.path());
     assert!(
         fastest < 1e-3,
         "the water around a fixed body moved at {fastest} m/s"
@@ -546,10 +552,7 @@ fn a_body_held_through_the_surface_leaves_still_water_still_and_feels_the_buoyan
     let body = "[[body]]\nshape = \"box\"\nmin = [0.25, 0.25]\nmax = [0.35, 0.35]\ndensity = 500.0\nmotion = \"fixed\"\n";
     let scene = scene_from_text(&tank(2, 0.01, [0.6, 0.5, 0.0], 0.3, 0.1, body));
     run_scene(&scene, dir.path(), 1.0);
-    let fastest = stats_column(dir.path(), "max_speed")
-        .into_iter()
-        .fold(0.0, f64::max);
-    eprintln!("the water's largest speed {fastest} m/s");
+    let fastest = largest_speed(dir.path());
     assert!(
         fastest < 1e-3,
         "the water beside a body held through its surface moved at {fastest} m/s"
