@@ -32,7 +32,7 @@ fn a_piston_makes_the_waves_biesel_gives() {
 
 /// At the scene's h/dx = 40: measured +1.0%, +2.3%, +2.3%.
 #[test]
-#[ignore = "about 4 minutes on 2 cores: run with --ignored"]
+#[ignore = "about 5 minutes on 2 cores: run with --ignored"]
 fn a_piston_makes_the_waves_biesel_gives_at_forty_particles_in_the_depth() {
     assert_biesel_height(0.005);
 }
