@@ -660,8 +660,8 @@ struct Row<const D: usize> {
     c: [F64s; D],
     /// ρ0_i and i's distance to the nearest interface.
     density: Side<D>,
-    /// Row i is a fluid particle's in a scene with ghost rows: its held-body neighbours are
-    /// known differences (`GhostRows::beside_fluid`), not unknowns.
+    /// Row i is a fluid particle's in a scene with ghost rows: its ghost neighbours are known
+    /// differences (`ghost_differences`), not unknowns (`unknown_weights`).
     fluid: bool,
 }
 
@@ -967,7 +967,9 @@ impl<const D: usize> Aggregated<D> for PressureOperator<'_, D> {
             let (w, slot) = (w.to_array(), slot.to_array());
             for (k, w) in w.into_iter().enumerate() {
                 // A ghost follows the water beside it: the coarse level carries a water
-                // particle's correction into its ghosts, and their pair adds nothing.
+                // particle's correction into its ghosts, and their pair adds nothing. (A water
+                // row's ghost weights are zero already, `unknown_weights`; this leaves out the
+                // pairs of a body's own deeper rows with its ghosts.)
                 if w == 0.0 || self.roles[l.j0 + k] == Role::Ghost {
                     continue;
                 }
