@@ -245,6 +245,11 @@ impl RigidBody {
         rotation::apply(r, self.offsets[(id - self.first_id) as usize])
     }
 
+    /// Where particle `id` lies under the surface (in the body's own frame).
+    pub fn surface_point(&self, id: u64) -> SurfacePoint {
+        self.surface[(id - self.first_id) as usize]
+    }
+
     /// The outward surface normal at particle `id` (`SurfacePoint`), in the world frame, for
     /// rotation `r`.
     pub fn normal(&self, r: &Mat3, id: u64) -> Vec3 {
@@ -545,9 +550,10 @@ impl Bodies {
 
     /// Advances body b's state over the step from `time` to `time + dt` from the momentum
     /// `impulse` and angular momentum `angular_impulse` the step's fluid stages gave its particles
-    /// beyond their rigid motion, `applied` the body forces' share of them per unit time (the
-    /// sums of m_i f_i and of r_ic × m_i f_i, `ghosts::BodyForce`); a fixed or prescribed one is
-    /// put where its motion says. A resting body stays where it is, and takes as its velocity
+    /// beyond their rigid motion, and `force` and `torque`, the fluid's over the step (the
+    /// impulses per unit time less the body forces' share of them; for a held body the
+    /// pressure's part taken from the water's side, `step::rigid_bodies`); a fixed or
+    /// prescribed one is put where its motion says. A resting body stays where it is, and takes as its velocity
     /// what the fluid's force and `load` (the body forces on its own masses: its weight and
     /// external force, in a moving container the frame's) would give it over the step from
     /// rest; its contacts then hold it or let it go (`resolve_contacts`, after every body has
@@ -565,9 +571,8 @@ impl Bodies {
     pub fn advance(
         &mut self,
         b: usize,
-        impulse: Vec3,
-        angular_impulse: Vec3,
-        applied: [Vec3; 2],
+        [impulse, angular_impulse]: [Vec3; 2],
+        [force, torque]: [Vec3; 2],
         load: [Vec3; 2],
         wet: bool,
         time: f64,
@@ -575,10 +580,6 @@ impl Bodies {
     ) {
         let body = &mut self.bodies[b];
         let s = body.state;
-        let (force, torque): (Vec3, Vec3) = (
-            std::array::from_fn(|d| impulse[d] / dt - applied[0][d]),
-            std::array::from_fn(|d| angular_impulse[d] / dt - applied[1][d]),
-        );
         if let Some(target) = body.target(time, dt) {
             body.state = RigidState {
                 centre: target.centre,

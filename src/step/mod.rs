@@ -463,7 +463,19 @@ impl<const D: usize> Step<D> {
             laps.lap(corrector::NAME);
             let velocity = self.corrector.velocity_scratch();
             if let (Some(stage), Some(force)) = (&mut self.rigid_bodies, force) {
-                stage.run(&nb, p, bodies, force, &loads, velocity, time, dt);
+                stage.run(
+                    &nb,
+                    p,
+                    bodies,
+                    force,
+                    &loads,
+                    grad_p,
+                    surface.roles,
+                    set.spacing,
+                    velocity,
+                    time,
+                    dt,
+                );
                 laps.lap(rigid_bodies::NAME);
             }
             // Into the particles: uⁿ⁺¹ (the bodies' rigid).
