@@ -69,6 +69,9 @@ pub fn end_of_frames(dir: &Path, frames: usize, bodies: usize) -> Result<u64, Ou
     end_of_row(&dir.join(FILE_NAME), HEADER, at)
 }
 
+/// The column of fx among a row's numbers x … tz (`read`).
+pub const FX: usize = 13;
+
 /// The bodies.csv of `dir`: its rows as (time, body, numbers x … tz).
 pub fn read(dir: &Path) -> Result<Vec<(f64, usize, Vec<f64>)>, OutputError> {
     let path = dir.join(FILE_NAME);
