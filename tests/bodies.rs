@@ -615,6 +615,35 @@ fn a_piston_held_in_still_water_feels_the_water_on_its_wet_face_only() {
     );
 }
 
+#[test]
+fn held_bodies_on_the_floor_and_through_the_surface_feel_the_water_on_their_wet_faces_only() {
+    // In still water 0.3 m deep: a box 0.1 × 0.05 m held on the floor, which no water reaches
+    // under it: the water above presses it down, ρ g (h − 0.05) × 0.1 m (its buoyancy, 49 N/m
+    // up, would count the floor's face as wet); and a circle of radius 0.05 m held with its
+    // centre on the surface: the buoyancy of its wet half, ρ g π r²/2. Measured at dx = 0.01
+    // m: −0.04% and +1.5% (the lattice's half disc), at 0.005 m −0.06% and +0.4% (2026-12-07).
+    let dir = TempDir::new("bodies-held-dry-faces");
+    let bodies = "[[body]]\nshape = \"box\"\nmin = [0.25, 0.0]\nmax = [0.35, 0.05]\ndensity = 2000.0\nmotion = \"fixed\"\n\n\
+                  [[body]]\nshape = \"circle\"\ncenter = [0.1, 0.3]\nradius = 0.05\ndensity = 500.0\nmotion = \"fixed\"\n";
+    let scene = scene_from_text(&tank(2, 0.01, [0.6, 0.5, 0.0], 0.3, 0.05, bodies));
+    run_scene(&scene, dir.path(), 0.3);
+    let (rho, g) = (1000.0, 9.81);
+    let pressed = -rho * g * (0.3 - 0.05) * 0.1;
+    let fy = mean_after(&rows(dir.path(), 0), FY, 0.1);
+    eprintln!("box on the floor: fy {fy} against {pressed}");
+    assert!(
+        (fy / pressed - 1.0).abs() < 0.01,
+        "fy {fy} N/m on a box on the floor against {pressed}"
+    );
+    let half = rho * g * std::f64::consts::PI * 0.05 * 0.05 / 2.0;
+    let fy = mean_after(&rows(dir.path(), 1), FY, 0.1);
+    eprintln!("circle through the surface: fy {fy} against {half}");
+    assert!(
+        (fy / half - 1.0).abs() < 0.03,
+        "fy {fy} N/m on a circle half under water against {half}"
+    );
+}
+
 /// Heavy bodies lying on the floor of still water 0.3 m deep from the start (`body` their
 /// sections): the water's kinetic energy [J/m] at every frame from 1 s to 2 s, and the bodies'
 /// largest speed [m/s] over the whole run.
