@@ -13,7 +13,8 @@ use isph::tools::validation::{measure, Case};
 /// in dx, −3.0% at h/20 in still water) and its first harmonic within 10% and 15° of the
 /// linear wave maker's, 22 N/m in phase with the piston's velocity (the wave it radiates).
 /// Measured at h/20 −2.3%, −2.6%, +8.9° (with frames every 0.02 s −2.4%, +0.4%, +4.0°: single
-/// periods scatter by 2–8°), at h/40 −1.5%, −1.0%, +2.0° (2026-12-07, Zen 3).
+/// periods scatter by 2–8°), at h/40 −1.5%, −4.1%, +2.1° (−1.5%, −1.0%, +2.0°) (2026-12-07,
+/// Zen 3).
 fn assert_biesel_height(spacing: f64) {
     let mut scene = shipped_scene("wave_flume_2d.toml");
     scene.spacing = spacing;
@@ -40,7 +41,7 @@ fn a_piston_makes_the_waves_biesel_gives() {
     assert_biesel_height(0.01);
 }
 
-/// At the scene's h/dx = 40: measured −1.4% to +1.3% (2026-12-07, Zen 3).
+/// At the scene's h/dx = 40: measured −1.8% to +1.1%, 254 s (2026-12-07, Zen 3).
 #[test]
 #[ignore = "about 5 minutes on 2 cores: run with --ignored"]
 fn a_piston_makes_the_waves_biesel_gives_at_forty_particles_in_the_depth() {
