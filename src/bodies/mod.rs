@@ -21,7 +21,7 @@
 mod contact;
 
 use crate::math::aabb::Aabb;
-use crate::math::rotation::{self, cross, Mat3, Quaternion, Vec3};
+use crate::math::rotation::{self, cross, to_3d, Mat3, Quaternion, Vec3};
 use crate::math::shape::Shape;
 use crate::math::vector::dot;
 use crate::particles::{Kind, Particles};
@@ -333,9 +333,7 @@ impl Bodies {
                 let members: Vec<usize> = (0..p.len())
                     .filter(|&i| p.kind[i] == Kind::Body && p.fluid[i] as usize == b)
                     .collect();
-                let at = |i: usize| -> Vec3 {
-                    std::array::from_fn(|d| if d < D { p.pos[d][i] } else { 0.0 })
-                };
+                let at = |i: usize| -> Vec3 { to_3d::<D>(|d| p.pos[d][i]) };
                 let mass: f64 = members.iter().map(|&i| p.mass[i]).sum();
                 let moment: Vec3 = members.iter().fold([0.0; 3], |s, &i| {
                     let x = at(i);

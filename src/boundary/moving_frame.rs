@@ -14,7 +14,7 @@
 //! (u_b = a_b = 0 in `ghosts::Motion`), and the Neumann condition of its ghost pressure carries
 //! f: ∂P/∂n = ρ0 f·n (`ghosts::ghost_pressure_difference`).
 
-use crate::math::rotation::{apply_transposed, cross, Quaternion, Vec3};
+use crate::math::rotation::{apply_transposed, cross, to_3d, Quaternion, Vec3};
 use crate::scene::trajectory::Trajectory;
 
 /// The container's motion and the gravity it moves in.
@@ -68,8 +68,8 @@ impl MovingFrame {
 impl FrameForce {
     /// f at position x with velocity u, both in the frame.
     pub fn at<const D: usize>(&self, x: [f64; D], u: [f64; D]) -> [f64; D] {
-        let r: Vec3 = std::array::from_fn(|d| if d < D { x[d] - self.pivot[d] } else { 0.0 });
-        let u: Vec3 = std::array::from_fn(|d| if d < D { u[d] } else { 0.0 });
+        let r: Vec3 = to_3d::<D>(|d| x[d] - self.pivot[d]);
+        let u: Vec3 = to_3d::<D>(|d| u[d]);
         let euler = cross(self.alpha, r);
         let centrifugal = cross(self.omega, cross(self.omega, r));
         let coriolis = cross(self.omega, u);

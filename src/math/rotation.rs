@@ -6,6 +6,12 @@ pub type Vec3 = [f64; 3];
 /// A 3 × 3 matrix, row-major.
 pub type Mat3 = [[f64; 3]; 3];
 
+/// The 3-vector of a D-vector's components `f(d)`, zero beyond D (in 2D, z = 0).
+#[inline]
+pub fn to_3d<const D: usize>(f: impl Fn(usize) -> f64) -> Vec3 {
+    std::array::from_fn(|d| if d < D { f(d) } else { 0.0 })
+}
+
 /// a × b.
 pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
     [

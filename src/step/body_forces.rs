@@ -26,7 +26,7 @@ use crate::bodies::{rigid_velocity, Bodies};
 use crate::boundary::moving_frame::{FrameForce, MovingFrame};
 use crate::math::memory::ArraySize;
 use crate::math::reduce::fill_vector;
-use crate::math::rotation::{apply, cross, inverse_on_span, to_world, Mat3, Vec3};
+use crate::math::rotation::{apply, cross, inverse_on_span, to_3d, to_world, Mat3, Vec3};
 use crate::neighbours::Neighbours;
 use crate::particles::{components, Kind, Particles};
 use crate::sph::interface;
@@ -235,20 +235,9 @@ impl<const D: usize> BodyForces<D> {
                 continue;
             }
             let f = ambient(frame.as_ref(), set, p, i);
-            let mf: Vec3 = std::array::from_fn(|d| {
-                if d < D {
-                    body.particle_mass * (f[d] + body.external_force[d] / body.mass)
-                } else {
-                    0.0
-                }
-            });
-            let arm: Vec3 = std::array::from_fn(|d| {
-                if d < D {
-                    p.pos[d][i] - body.state.centre[d]
-                } else {
-                    0.0
-                }
-            });
+            let mf: Vec3 =
+                to_3d::<D>(|d| body.particle_mass * (f[d] + body.external_force[d] / body.mass));
+            let arm: Vec3 = to_3d::<D>(|d| p.pos[d][i] - body.state.centre[d]);
             let torque = cross(arm, mf);
             for d in 0..3 {
                 loads[b][0][d] += mf[d];
@@ -325,7 +314,7 @@ fn rigid_accelerations<const D: usize>(
     let (mut sum, mut moment) = (vec![[0.0; 3]; count], vec![[0.0; 3]; count]);
     for (&i, a) in members.iter().zip(accelerations) {
         let b = p.fluid[i] as usize;
-        let ma: Vec3 = std::array::from_fn(|d| if d < D { p.mass[i] * a[d] } else { 0.0 });
+        let ma: Vec3 = to_3d::<D>(|d| p.mass[i] * a[d]);
         let t = cross(arm(i), ma);
         for d in 0..3 {
             sum[b][d] += ma[d];

@@ -6,7 +6,7 @@
 use super::{Stage, StepSettings};
 use crate::bodies::{rigid_velocity, Bodies, RigidBody};
 use crate::math::memory::ArraySize;
-use crate::math::rotation::{cross, Vec3};
+use crate::math::rotation::{cross, to_3d, Vec3};
 use crate::neighbours::Neighbours;
 use crate::particles::{Kind, Particles};
 use crate::solver::ppe::Role;
@@ -85,19 +85,11 @@ impl RigidBodies {
             let i = i as usize;
             let b = p.fluid[i] as usize;
             let (v, w, centre) = rigid_now[b];
-            let arm: Vec3 =
-                std::array::from_fn(|d| if d < D { p.pos[d][i] - centre[d] } else { 0.0 });
+            let arm: Vec3 = to_3d::<D>(|d| p.pos[d][i] - centre[d]);
             let rigid = rigid_velocity(v, w, arm);
-            let du: Vec3 = std::array::from_fn(|d| {
-                if d < D {
-                    p.mass[i] * (velocity[d][i] - rigid[d])
-                } else {
-                    0.0
-                }
-            });
+            let du: Vec3 = to_3d::<D>(|d| p.mass[i] * (velocity[d][i] - rigid[d]));
             let t = cross(arm, du);
-            let mf: Vec3 =
-                std::array::from_fn(|d| if d < D { p.mass[i] * force[d][i] } else { 0.0 });
+            let mf: Vec3 = to_3d::<D>(|d| p.mass[i] * force[d][i]);
             let mf_t = cross(arm, mf);
             for d in 0..3 {
                 impulse[b][d] += du[d];
@@ -109,13 +101,7 @@ impl RigidBodies {
             if driven[b] && reaches_a_dry_face(nb, p, roles, &self.dry, i) {
                 let symmetric = symmetric_pressure_force(nb, p, i);
                 let volume = p.mass[i] / p.rest_density[i];
-                let e: Vec3 = std::array::from_fn(|d| {
-                    if d < D {
-                        volume.mul_add(pressure_gradient[d][i], symmetric[d])
-                    } else {
-                        0.0
-                    }
-                });
+                let e: Vec3 = to_3d::<D>(|d| volume.mul_add(pressure_gradient[d][i], symmetric[d]));
                 let e_t = cross(arm, e);
                 for d in 0..3 {
                     dry_faces[b][0][d] += e[d];
@@ -189,8 +175,8 @@ impl RigidBodies {
         }
         let mut crossings = 0;
         for i in (0..nf).filter(|&i| p.kind[i] == Kind::Fluid) {
-            let mut x = std::array::from_fn(|d| if d < D { p.pos[d][i] } else { 0.0 });
-            let mut u = std::array::from_fn(|d| if d < D { p.vel[d][i] } else { 0.0 });
+            let mut x = to_3d::<D>(|d| p.pos[d][i]);
+            let mut u = to_3d::<D>(|d| p.vel[d][i]);
             let (moved, crossed) = bodies.keep_out(&mut x, &mut u, 0.25 * spacing, D);
             crossings += crossed as usize;
             if moved {
