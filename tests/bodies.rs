@@ -549,7 +549,7 @@ fn a_body_held_through_the_surface_leaves_still_water_still_and_feels_the_buoyan
     // line was pushed off the box every step, and the tank sloshed ever more: 0.12 m/s within
     // 1 s, the kinetic energy from 2e-3 to 9e-2 J/m over 6 s (2026-12-07). Measured unclipped:
     // 1.8e-4 m/s at most over 1 s (1.4e-3 at most over 20 s: the solve's tolerance), the force
-    // 1.3% under the wet part's buoyancy.
+    // 0.05% under the wet part's buoyancy (1.3% while its dry faces counted).
     let dir = TempDir::new("bodies-held-through-the-surface");
     let body = "[[body]]\nshape = \"box\"\nmin = [0.25, 0.25]\nmax = [0.35, 0.35]\ndensity = 500.0\nmotion = \"fixed\"\n";
     let scene = scene_from_text(&tank(2, 0.01, [0.6, 0.5, 0.0], 0.3, 0.1, body));
