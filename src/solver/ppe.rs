@@ -731,11 +731,11 @@ impl<const D: usize> PressureOperator<'_, D> {
     }
 
     /// The weights of free-surface row i with its fluid neighbours `l`, the unknowns among
-    /// them.
+    /// them (`fluid`: `is_fluid_row(i)`).
     #[inline(always)]
-    fn surface_unknown_weights(&self, i: usize, l: &Lanes<D>) -> F64s {
+    fn surface_unknown_weights(&self, i: usize, fluid: bool, l: &Lanes<D>) -> F64s {
         let w = self.surface_weights(i, l, l.load(self.fluid_volume));
-        self.unknown_weights(self.is_fluid_row(i), l, w)
+        self.unknown_weights(fluid, l, w)
     }
 
     /// Σ_b w_ib (P_b − P_i) over the ghosts b of fluid particle i's row, `weights` their w_ib:
@@ -790,7 +790,9 @@ impl<const D: usize> PressureOperator<'_, D> {
             }
             Role::Surface => {
                 // P_i + Σ_j w_ij (P_j − P_i).
-                let d = self.weighted_differences(x, i, |l| self.surface_unknown_weights(i, l));
+                let fluid = self.is_fluid_row(i);
+                let d =
+                    self.weighted_differences(x, i, |l| self.surface_unknown_weights(i, fluid, l));
                 std::array::from_fn(|k| x[k][i] - d[k])
             }
             Role::Ghost => self.ghost_rows(x, i),
@@ -905,9 +907,9 @@ impl<const D: usize> LinearOperator for PressureOperator<'_, D> {
                 interior_diagonal(d)
             }
             Role::Surface => {
-                let mut d = Sum::ZERO;
+                let (fluid, mut d) = (self.is_fluid_row(i), Sum::ZERO);
                 self.nb.for_each_lanes_of(i, &[Kind::Fluid], |l| {
-                    d += self.surface_unknown_weights(i, l)
+                    d += self.surface_unknown_weights(i, fluid, l)
                 });
                 1.0 - d.total()
             }

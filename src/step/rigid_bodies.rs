@@ -120,19 +120,11 @@ impl RigidBodies {
                 dry_faces[b] = [[0.0; 3]; 2];
             }
             // The fluid's force and torque on the body over the step.
-            let water = [0, 1].map(|k| -> Vec3 {
-                let change = if k == 0 { impulse[b] } else { angular[b] };
-                std::array::from_fn(|d| change[d] / dt - applied[b][k][d] + dry_faces[b][k][d])
+            let change = [impulse[b], angular[b]];
+            let water: [Vec3; 2] = std::array::from_fn(|k| {
+                std::array::from_fn(|d| change[k][d] / dt - applied[b][k][d] + dry_faces[b][k][d])
             });
-            bodies.advance(
-                b,
-                [impulse[b], angular[b]],
-                water,
-                loads[b],
-                touched[b],
-                time,
-                dt,
-            );
+            bodies.advance(b, change, water, loads[b], touched[b], time, dt);
         }
         bodies.resolve_contacts(time, dt);
         let poses: Vec<_> = bodies

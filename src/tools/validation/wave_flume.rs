@@ -58,10 +58,9 @@ const SETTLING_PERIODS: f64 = 2.0;
 /// the piston's face.
 #[derive(Clone, Debug)]
 pub struct Flume {
-    /// ω [rad/s] and the stroke S [m].
+    /// ω [rad/s].
     pub frequency: f64,
-    pub stroke: f64,
-    /// a of the piston's motion X(t) = a sin ωt [m] (S = 2|a|).
+    /// a of the piston's motion X(t) = a sin ωt [m]: the stroke is S = 2|a|.
     pub amplitude: f64,
     /// h [m], |g| [m/s²] and the water's ρ0 [kg/m³].
     pub depth: f64,
@@ -129,7 +128,6 @@ impl Flume {
         }
         Ok(Flume {
             frequency: 2.0 * PI / period,
-            stroke: 2.0 * amplitude.abs(),
             amplitude,
             depth,
             gravity,
@@ -161,7 +159,8 @@ impl Flume {
     /// Biesel's first-order wave height of the piston's stroke.
     pub fn reference_height(&self) -> f64 {
         let kh2 = 2.0 * self.wavenumber() * self.depth;
-        self.stroke * 2.0 * (kh2.cosh() - 1.0) / (kh2.sinh() + kh2)
+        let stroke = 2.0 * self.amplitude.abs();
+        stroke * 2.0 * (kh2.cosh() - 1.0) / (kh2.sinh() + kh2)
     }
 
     /// The linear wave maker's force on the piston along x (Havelock 1929; Dean & Dalrymple
@@ -333,7 +332,6 @@ mod tests {
     fn linear_theory_of_the_shipped_flume() {
         let flume = Flume {
             frequency: 2.0 * PI,
-            stroke: 1.0,
             amplitude: 0.5,
             depth: 0.2,
             gravity: 9.81,
