@@ -250,16 +250,23 @@ fn lobovsky_onset_and_plateau_of_a_known_curve() {
     assert_eq!(window_mean(&curve, (3.5, 6.5)), None);
 }
 
-/// The experiment's onsets and plateaus as docs/accuracy.md gives them.
+/// The experiment's onsets and plateaus, and its gauges' mean levels, as docs/accuracy.md gives
+/// them.
 #[test]
 fn lobovsky_experiment_onsets_and_plateaus() {
-    use isph::tools::validation::lobovsky::{onset, window_mean, ONSET_LEVEL, PLATEAU, SENSORS};
+    use isph::tools::validation::lobovsky::{
+        onset, window_mean, GAUGES, LEVEL_WINDOW, ONSET_LEVEL, PLATEAU, SENSORS,
+    };
     let expected = [
         (2.408, 0.594),
         (2.458, 0.662),
         (2.517, 0.585),
         (2.763, 0.520),
     ];
+    for (gauge, h) in GAUGES.iter().zip([0.6499, 0.2267, 0.1491, 0.1021]) {
+        let level = window_mean(&gauge.curve(), LEVEL_WINDOW).unwrap();
+        assert!((level - h).abs() < 5e-4, "{}: level {level}", gauge.name);
+    }
     for (sensor, (t, p)) in SENSORS.iter().zip(expected) {
         let curve = sensor.curve();
         let on = onset(&curve, ONSET_LEVEL).unwrap();
@@ -283,6 +290,20 @@ fn a_scene_without_the_sensors_is_not_measured_against_lobovsky() {
     scene.probes.remove(0);
     let e = isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap_err();
     assert!(e.to_string().contains("no pressure probe named P1"), "{e}");
+}
+
+/// The water-level gauges are optional, but one the scene has stands where the experiment's
+/// does.
+#[test]
+fn a_lobovsky_gauge_stands_where_the_experiments_does() {
+    let mut scene = crate::common::shipped_scene("dam_break_lobovsky_2d.toml");
+    let gauge = |scene: &isph::scene::Scene| scene.probes.iter().position(|p| p.name == "H3");
+    let k = gauge(&scene).unwrap();
+    scene.probes[k].point[0] = 1.2;
+    let e = isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap_err();
+    assert!(e.to_string().contains("gauge 3 is a wave gauge"), "{e}");
+    scene.probes.remove(k);
+    isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap();
 }
 
 /// `density`: the worst step's density error, its mean over the steps that measured one (a NaN

@@ -14,10 +14,17 @@
 //!   come down from the impact by T = 3.4 (sensor 3's falls to 0.63 at 3.34) and stay between
 //!   0.46 and 0.71 until the wave that plunged back from the wall hits again at T ≈ 5.8.
 //!
+//! The flow that brings the water to the wall is compared too, where the scene has the
+//! experiment's water-level gauges H1–H4 (wave gauges, `field = "elevation"`, on the vertical
+//! lines 300, 865, 1114 and 1362.5 mm from the column's wall, scaled by H/300 mm): the mean of
+//! h/H over T in `LEVEL_WINDOW` (0.5–5.5, from just after the release until the wave that plunged back from
+//! the wall reaches H4), against the experiment's (a dry gauge reads h = 0, as the experiment's).
+//!
 //! The error is the mean of |T_onset − T_onset,exp| / T_onset,exp over the four sensors.
 //! Details, per sensor k: `onset_error_Pk` and `plateau_error_Pk` (signed, relative to the
-//! experiment's), `onset_Pk` (T) and `plateau_Pk` (P/(ρ0 g H)) of the run; a plateau whose window
-//! the run did not reach, or an onset it did not, is NaN.
+//! experiment's), `onset_Pk` (T) and `plateau_Pk` (P/(ρ0 g H)) of the run; per gauge k,
+//! `level_error_Hk`, the run's mean level relative to the experiment's (signed). A plateau or a level
+//! whose window the run did not reach, an onset it did not, or a gauge the scene lacks, is NaN.
 
 use super::{
     first_block, surge_vertical, unsuitable, Case, Measured, ProbeCurves, ValidationError,
@@ -25,7 +32,7 @@ use super::{
 use crate::scene::{ProbeField, Scene};
 use std::path::Path;
 
-pub const DETAILS: [&str; 16] = [
+pub const DETAILS: [&str; 20] = [
     "onset_error_P1",
     "onset_error_P2",
     "onset_error_P3",
@@ -42,6 +49,10 @@ pub const DETAILS: [&str; 16] = [
     "plateau_P2",
     "plateau_P3",
     "plateau_P4",
+    "level_error_H1",
+    "level_error_H2",
+    "level_error_H3",
+    "level_error_H4",
 ];
 
 /// The level of P/(ρ0 g H) whose first crossing is the onset.
@@ -49,6 +60,9 @@ pub const ONSET_LEVEL: f64 = 0.1;
 
 /// The window of T over which the plateau is averaged.
 pub const PLATEAU: (f64, f64) = (3.5, 5.5);
+
+/// The window of T over which the water levels are averaged.
+pub const LEVEL_WINDOW: (f64, f64) = (0.5, 5.5);
 
 /// The experiment's column height [m]: sensor heights scale with H/EXPERIMENT_HEIGHT.
 const EXPERIMENT_HEIGHT: f64 = 0.3;
@@ -85,17 +99,60 @@ pub const SENSORS: [Sensor; 4] = [
 ];
 
 impl Sensor {
-    /// The experiment's curve: (T, P/(ρ0 g H)) in the file's order (`#` lines and the `T,P`
-    /// header skipped).
+    /// The experiment's curve: (T, P/(ρ0 g H)).
     pub fn curve(&self) -> Vec<(f64, f64)> {
-        self.csv
-            .lines()
-            .filter_map(|l| {
-                let (t, p) = l.split_once(',')?;
-                Some((t.parse().ok()?, p.parse().ok()?))
-            })
-            .collect()
+        curve_of(self.csv)
     }
+}
+
+/// A water-level gauge of the experiment: its probe's name, the distance of its vertical line
+/// from the column's wall in the experiment [m], and its curve (T, h/H) as a CSV file of
+/// `docs/accuracy/lobovsky_2014/`.
+pub struct Gauge {
+    pub name: &'static str,
+    pub distance: f64,
+    pub csv: &'static str,
+}
+
+pub const GAUGES: [Gauge; 4] = [
+    Gauge {
+        name: "H1",
+        distance: 0.3,
+        csv: include_str!("../../../docs/accuracy/lobovsky_2014/gauge1.csv"),
+    },
+    Gauge {
+        name: "H2",
+        distance: 0.865,
+        csv: include_str!("../../../docs/accuracy/lobovsky_2014/gauge2.csv"),
+    },
+    Gauge {
+        name: "H3",
+        distance: 1.114,
+        csv: include_str!("../../../docs/accuracy/lobovsky_2014/gauge3.csv"),
+    },
+    Gauge {
+        name: "H4",
+        distance: 1.3625,
+        csv: include_str!("../../../docs/accuracy/lobovsky_2014/gauge4.csv"),
+    },
+];
+
+impl Gauge {
+    /// The experiment's curve: (T, h/H).
+    pub fn curve(&self) -> Vec<(f64, f64)> {
+        curve_of(self.csv)
+    }
+}
+
+/// The (T, value) rows of an experiment's CSV file in its order (`#` lines and the header
+/// skipped).
+fn curve_of(csv: &str) -> Vec<(f64, f64)> {
+    csv.lines()
+        .filter_map(|l| {
+            let (t, p) = l.split_once(',')?;
+            Some((t.parse().ok()?, p.parse().ok()?))
+        })
+        .collect()
 }
 
 /// The first T at which the curve exceeds `level`, linearly interpolated; None if it never does.
@@ -128,19 +185,26 @@ pub fn window_mean(curve: &[(f64, f64)], (a, b): (f64, f64)) -> Option<f64> {
     Some(integral / (b - a))
 }
 
-/// The tank of a scene: what turns probes.csv into the paper's T and P/(ρ0 g H).
+/// The tank of a scene: what turns probes.csv into the paper's T, P/(ρ0 g H) and h/H.
 #[derive(Clone, Copy, Debug)]
 pub struct Tank {
     /// √(g/H) [1/s]: T = t · time_scale.
     pub time_scale: f64,
     /// ρ0 g H [Pa].
     pub pressure_scale: f64,
+    /// The floor's height [m] and H [m]: h/H = (z − floor)/H.
+    pub floor: f64,
+    pub height: f64,
+    /// Whether the scene has each of the gauges H1–H4.
+    pub gauges: [bool; 4],
 }
 
 impl Tank {
     /// Checks that the scene's first fluid block is the column (height H) and that it has the
     /// pressure probes P1–P4 on the far (max-x) wall, within half a spacing of its face, at the
-    /// sensors' heights scaled by H/300 mm (within half of the sensors' 4.2 mm).
+    /// sensors' heights scaled by H/300 mm (within half of the sensors' 4.2 mm), and that
+    /// those of the gauges H1–H4 it has stand at their distances from the column's wall scaled
+    /// by H/300 mm, within half a spacing.
     pub fn new(scene: &Scene) -> Result<Self, ValidationError> {
         let case = Case::LobovskyPressure;
         let (v, g) = surge_vertical(case, scene)?;
@@ -173,10 +237,33 @@ impl Tank {
                 )));
             }
         }
+        let mut gauges = [false; 4];
+        for (k, gauge) in GAUGES.iter().enumerate() {
+            let Some(probe) = scene.probes.iter().find(|p| p.name == gauge.name) else {
+                continue;
+            };
+            let x = column.min[0] + gauge.distance * scale;
+            if probe.field != ProbeField::Elevation
+                || (probe.point[0] - x).abs() > 0.5 * scene.spacing
+            {
+                return Err(scene_error(format!(
+                    "probe {} is a {} probe at {:?}; gauge {} is a wave gauge (field = \"elevation\") at x = {x:.4} m ({} mm from the column's wall scaled by H/300 mm)",
+                    gauge.name,
+                    probe.field.name(),
+                    probe.point,
+                    &gauge.name[1..],
+                    gauge.distance * 1e3
+                )));
+            }
+            gauges[k] = true;
+        }
         let rho = scene.fluids[scene.blocks[0].fluid].density;
         Ok(Self {
             time_scale: (g / height).sqrt(),
             pressure_scale: rho * g * height,
+            floor: column.min[v],
+            height,
+            gauges,
         })
     }
 }
@@ -185,7 +272,7 @@ pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationErro
     let case = Case::LobovskyPressure;
     let tank = Tank::new(scene)?;
     let probes = ProbeCurves::read(case, run_dir)?;
-    let mut values = [f64::NAN; 16];
+    let mut values = [f64::NAN; 20];
     for (k, sensor) in SENSORS.iter().enumerate() {
         let run: Vec<(f64, f64)> = probes
             .curve(sensor.name)?
@@ -201,6 +288,26 @@ pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationErro
         values[4 + k] = run_plateau.map_or(nan, |p| (p - exp_plateau) / exp_plateau);
         values[8 + k] = run_onset.unwrap_or(nan);
         values[12 + k] = run_plateau.unwrap_or(nan);
+    }
+    for (k, gauge) in GAUGES.iter().enumerate().filter(|&(k, _)| tank.gauges[k]) {
+        // A dry gauge (NaN) reads no water, as the experiment's.
+        let run: Vec<(f64, f64)> = probes
+            .curve(gauge.name)?
+            .into_iter()
+            .map(|(t, z)| {
+                (
+                    t * tank.time_scale,
+                    if z.is_nan() {
+                        0.0
+                    } else {
+                        (z - tank.floor) / tank.height
+                    },
+                )
+            })
+            .collect();
+        let experiment = window_mean(&gauge.curve(), LEVEL_WINDOW).expect("every curve spans it");
+        values[16 + k] =
+            window_mean(&run, LEVEL_WINDOW).map_or(f64::NAN, |h| (h - experiment) / experiment);
     }
     if values[..4].iter().all(|e| e.is_nan()) {
         let end = probes.end();
