@@ -67,10 +67,10 @@ fn dam_break_3d_runs_half_a_second() {
 
 /// Lobovsky et al.'s dam break (`scenes/dam_break_lobovsky_2d.toml`, H/40) to t = 0.97 s
 /// (t √(g/H) = 5.55): the water's level at the experiment's four gauges, averaged over
-/// t √(g/H) = 0.5–5.5, within 20% of the experiment's. Measured: −3.5%, +7.9%, +10.9%, +13.4%
+/// t √(g/H) = 0.5–5.5, within 20% of the experiment's. Measured: −3.5%, +7.8%, +10.8%, +13.2%
 /// (the column drains ahead of the experiment's, whose gate takes time to lift, and the water
 /// arrives downstream ahead of it; docs/accuracy.md, "The water levels"); a fluid a thousand
-/// times as viscous as water reads +16%, +21% and +24% at the last three.
+/// times as viscous as water read +16%, +21% and +24% at the last three.
 #[test]
 fn water_levels_follow_lobovsky() {
     let scene = shipped_scene("dam_break_lobovsky_2d.toml");

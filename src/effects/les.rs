@@ -13,6 +13,16 @@
 //! no-slip wall pairs of Eq. (26); the turbulent excess u_τ² − ν U/y acts on the layer of
 //! particles touching the wall (thickness dx), against their velocity along it.
 //!
+//! That stress has to cross the log layer, as it does in a turbulent boundary layer, where the
+//! eddy viscosity κ u_τ y carries it: ρ κ u_τ y ∂U/∂y = ρ u_τ² for the log profile. Smagorinsky's
+//! (Cs dx)² |S|, with |S| blind to the wall, is a hundredth of that a few spacings out, so the
+//! momentum the wall takes would come from the first layer alone: a layer one spacing thick,
+//! slowed more as the spacing shrinks, which the adverse pressure gradient at the foot of a wall
+//! that a surge runs into turns back into a vortex (docs/accuracy.md, "Wall pressures against
+//! Lobovsky et al. 2014"). So within a kernel support of a wall the eddy viscosity is at least
+//! κ u_τ y, u_τ from the particle's own speed along the wall at its distance y
+//! (`wall_layer_viscosity`).
+//!
 //! Cs and whether the wall function applies are the scene's `[effects.les]` (`LesSettings`).
 
 use crate::boundary::ghosts::Face;
@@ -76,6 +86,24 @@ pub fn wall_shear<const D: usize>(
         return [0.0; D];
     }
     u_t.map(|x| -excess / spacing * x / speed)
+}
+
+/// The eddy viscosity of the log layer, κ u_τ y, at fluid particle i at distance y from the
+/// wall `face`, u_τ from its speed along the wall (`friction_velocity`): the viscosity that
+/// carries the wall's shear stress ρ u_τ² across the layer.
+pub fn wall_layer_viscosity<const D: usize>(p: &Particles<D>, face: Face<D>, i: usize) -> f64 {
+    let (y, n) = (face.distance, face.normal);
+    let u = p.velocity(i);
+    let u_n: f64 = (0..D).map(|d| u[d] * n[d]).sum();
+    let speed = (0..D)
+        .map(|d| (u[d] - u_n * n[d]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let nu = p.viscosity[i];
+    if speed == 0.0 || nu == 0.0 {
+        return 0.0;
+    }
+    KARMAN * friction_velocity(speed, y, nu) * y
 }
 
 /// u_τ of the law of the wall for speed `u` at distance `y` from a smooth wall, kinematic

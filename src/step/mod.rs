@@ -377,7 +377,7 @@ impl<const D: usize> Step<D> {
                     .free_surface
                     .strain_rates()
                     .expect("with LES the free surface's walk finds the strain rates");
-                let eddy = stage.run(strain_rates, corrections, set.spacing);
+                let eddy = stage.run(&nb, p, strain_rates, corrections, set.spacing);
                 laps.lap(eddy_viscosity::NAME);
                 eddy
             });
