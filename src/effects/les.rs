@@ -73,9 +73,7 @@ pub fn wall_shear<const D: usize>(
     else {
         return [0.0; D];
     };
-    let u = p.velocity(i);
-    let u_n: f64 = (0..D).map(|d| u[d] * n[d]).sum();
-    let u_t: [f64; D] = std::array::from_fn(|d| u[d] - u_n * n[d]);
+    let u_t = velocity_along(p, n, i);
     let speed = u_t.iter().map(|x| x * x).sum::<f64>().sqrt();
     let nu = p.viscosity[i];
     if speed == 0.0 || nu == 0.0 {
@@ -92,11 +90,10 @@ pub fn wall_shear<const D: usize>(
 /// wall `face`, u_τ from its speed along the wall (`friction_velocity`): the viscosity that
 /// carries the wall's shear stress ρ u_τ² across the layer.
 pub fn wall_layer_viscosity<const D: usize>(p: &Particles<D>, face: Face<D>, i: usize) -> f64 {
-    let (y, n) = (face.distance, face.normal);
-    let u = p.velocity(i);
-    let u_n: f64 = (0..D).map(|d| u[d] * n[d]).sum();
-    let speed = (0..D)
-        .map(|d| (u[d] - u_n * n[d]).powi(2))
+    let y = face.distance;
+    let speed = velocity_along(p, face.normal, i)
+        .iter()
+        .map(|x| x * x)
         .sum::<f64>()
         .sqrt();
     let nu = p.viscosity[i];
@@ -104,6 +101,13 @@ pub fn wall_layer_viscosity<const D: usize>(p: &Particles<D>, face: Face<D>, i: 
         return 0.0;
     }
     KARMAN * friction_velocity(speed, y, nu) * y
+}
+
+/// The velocity of fluid particle i along a wall of normal `n`: its normal part taken out.
+fn velocity_along<const D: usize>(p: &Particles<D>, n: [f64; D], i: usize) -> [f64; D] {
+    let u = p.velocity(i);
+    let u_n: f64 = (0..D).map(|d| u[d] * n[d]).sum();
+    std::array::from_fn(|d| u[d] - u_n * n[d])
 }
 
 /// u_τ of the law of the wall for speed `u` at distance `y` from a smooth wall, kinematic
