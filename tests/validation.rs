@@ -297,8 +297,7 @@ fn a_scene_without_the_sensors_is_not_measured_against_lobovsky() {
 #[test]
 fn a_lobovsky_gauge_stands_where_the_experiments_does() {
     let mut scene = crate::common::shipped_scene("dam_break_lobovsky_2d.toml");
-    let gauge = |scene: &isph::scene::Scene| scene.probes.iter().position(|p| p.name == "H3");
-    let k = gauge(&scene).unwrap();
+    let k = scene.probes.iter().position(|p| p.name == "H3").unwrap();
     scene.probes[k].point[0] = 1.2;
     let e = isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap_err();
     assert!(e.to_string().contains("gauge 3 is a wave gauge"), "{e}");

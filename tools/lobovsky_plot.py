@@ -44,7 +44,7 @@ def experiment(name):
 
 
 def run(directory, column, time_scale, to_value):
-    """(T, to_value(x)) of a run's probes.csv column; a dry gauge (NaN) reads 0."""
+    """(T, to_value(x)) of the values x of a run's probes.csv column."""
     with open(pathlib.Path(directory) / "probes.csv") as f:
         rows = list(csv.DictReader(f))
     t = [float(r["time"]) * time_scale for r in rows]

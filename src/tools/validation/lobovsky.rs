@@ -17,14 +17,16 @@
 //! The flow that brings the water to the wall is compared too, where the scene has the
 //! experiment's water-level gauges H1–H4 (wave gauges, `field = "elevation"`, on the vertical
 //! lines 300, 865, 1114 and 1362.5 mm from the column's wall, scaled by H/300 mm): the mean of
-//! h/H over T in `LEVEL_WINDOW` (0.5–5.5, from just after the release until the wave that plunged back from
-//! the wall reaches H4), against the experiment's (a dry gauge reads h = 0, as the experiment's).
+//! h/H over T in `LEVEL_WINDOW` (0.5–5.5, from just after the release until the wave that
+//! plunged back from the wall reaches H4), against the experiment's (a dry gauge reads h = 0,
+//! as the experiment's).
 //!
 //! The error is the mean of |T_onset − T_onset,exp| / T_onset,exp over the four sensors.
 //! Details, per sensor k: `onset_error_Pk` and `plateau_error_Pk` (signed, relative to the
 //! experiment's), `onset_Pk` (T) and `plateau_Pk` (P/(ρ0 g H)) of the run; per gauge k,
-//! `level_error_Hk`, the run's mean level relative to the experiment's (signed). A plateau or a level
-//! whose window the run did not reach, an onset it did not, or a gauge the scene lacks, is NaN.
+//! `level_error_Hk`, the run's mean level relative to the experiment's (signed). A plateau or
+//! a level whose window the run did not reach, an onset it did not, or a gauge the scene
+//! lacks, is NaN.
 
 use super::{
     first_block, surge_vertical, unsuitable, Case, Measured, ProbeCurves, ValidationError,
@@ -289,21 +291,19 @@ pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationErro
         values[8 + k] = run_onset.unwrap_or(nan);
         values[12 + k] = run_plateau.unwrap_or(nan);
     }
+    // h/H of a gauge's height z; a dry gauge (NaN) reads no water, as the experiment's.
+    let level = |z: f64| {
+        if z.is_nan() {
+            0.0
+        } else {
+            (z - tank.floor) / tank.height
+        }
+    };
     for (k, gauge) in GAUGES.iter().enumerate().filter(|&(k, _)| tank.gauges[k]) {
-        // A dry gauge (NaN) reads no water, as the experiment's.
         let run: Vec<(f64, f64)> = probes
             .curve(gauge.name)?
             .into_iter()
-            .map(|(t, z)| {
-                (
-                    t * tank.time_scale,
-                    if z.is_nan() {
-                        0.0
-                    } else {
-                        (z - tank.floor) / tank.height
-                    },
-                )
-            })
+            .map(|(t, z)| (t * tank.time_scale, level(z)))
             .collect();
         let experiment = window_mean(&gauge.curve(), LEVEL_WINDOW).expect("every curve spans it");
         values[16 + k] =
