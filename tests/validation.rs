@@ -292,6 +292,19 @@ fn a_scene_without_the_sensors_is_not_measured_against_lobovsky() {
     assert!(e.to_string().contains("no pressure probe named P1"), "{e}");
 }
 
+/// The experiment's tank in 3D is measured as the 2D scene is: the sensors' heights along z.
+#[test]
+fn the_experiments_tank_in_3d_is_measured_as_the_2d_scene() {
+    let mut scene = crate::common::shipped_scene("dam_break_lobovsky_3d.toml");
+    isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap();
+    scene.probes[1].point[2] = 0.03;
+    let e = isph::tools::validation::check(Case::LobovskyPressure, &scene).unwrap_err();
+    assert!(
+        e.to_string().contains("probe P2 is at [1.61, 0.075, 0.03]"),
+        "{e}"
+    );
+}
+
 /// The water-level gauges are optional, but one the scene has stands where the experiment's
 /// does.
 #[test]

@@ -1,8 +1,9 @@
 //! Wall pressures of the dam break of Lobovsky et al. (2014), J. Fluids Struct. 48, 407–434,
-//! H = 300 mm: the probes P1–P4 of the scene (`scenes/dam_break_lobovsky_2d.toml`), on the far
-//! wall at the heights of the centres of the paper's sensors 1–4 (3, 15, 30, 80 mm, scaled by
-//! H/300 mm), against the experiment's curves (docs/accuracy/lobovsky_2014/, with their
-//! sources). Time is T = t √(g/H), pressure P/(ρ0 g H), as in the paper.
+//! H = 300 mm: the probes P1–P4 of the scene (`scenes/dam_break_lobovsky_2d.toml`, or `_3d` in
+//! the experiment's tank 150 mm wide), on the far wall at the heights of the centres of the
+//! paper's sensors 1–4 (3, 15, 30, 80 mm, scaled by H/300 mm), against the experiment's curves
+//! (docs/accuracy/lobovsky_2014/, with their sources). Time is T = t √(g/H), pressure
+//! P/(ρ0 g H), as in the paper.
 //!
 //! The impact peaks scatter widely between the experiment's repeats; two features do not, and
 //! are compared, each measured in the same way on the experiment's curve and on probes.csv:
