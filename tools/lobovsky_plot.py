@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Draws the wall pressures of runs of scenes/dam_break_lobovsky_2d.toml (or _3d.toml) against
-the experiment of Lobovsky et al. (2014), one panel per sensor (P1-P4), as P/(rho g H) against t sqrt(g/H),
-and with --levels the water levels at its gauges H1-H4 as h/H.
+the experiment of Lobovsky et al. (2014), one panel per sensor (P1-P4), as P/(rho g H) against
+t sqrt(g/H), and with --levels the water levels at its gauges H1-H4 as h/H.
 
     tools/lobovsky_plot.py RUN_DIR[=LABEL] [RUN_DIR[=LABEL] ...] [-o FILE.svg|png]
                            [--levels FILE.svg|png] [--height 0.3] [--density 1000]
