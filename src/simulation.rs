@@ -223,9 +223,10 @@ impl<const D: usize> Simulation<D> {
             ppe_residual: report.solve.relative_residual,
             max_speed: report.max_speed,
             kinetic_energy: report.kinetic_energy,
-            density_error: report.density_error,
+            density_error: report.full_support.density_error,
             penetrations: report.penetrations,
-            disorder: report.disorder,
+            disorder: report.full_support.disorder,
+            compression: report.full_support.compression,
         })
     }
 

@@ -304,15 +304,15 @@ fn water_sealed_off_from_the_free_surface_stays_at_rest() {
 }
 
 /// A layer of water shallower than a kernel support (4 particles, 3.6 dx deep) has no particle
-/// whose support is free of the free surface, so `stats.csv` measures no density error or
-/// disorder there: the columns say so (NaN) rather than report a perfect 0.
+/// whose support is free of the free surface, so `stats.csv` measures no density error,
+/// compression or disorder there: the columns say so (NaN) rather than report a perfect 0.
 #[test]
 fn a_layer_too_thin_for_a_full_support_reports_no_density_error() {
     let text =
         crate::common::water_block_scene(0.02).replace("max = [0.2, 0.2]", "max = [0.4, 0.08]");
     let dir = TempDir::new("thin-layer");
     run_scene(&scene_from_text(&text), dir.path(), 0.02);
-    for column in ["density_error", "disorder"] {
+    for column in ["density_error", "compression", "disorder"] {
         let values = stats_column(dir.path(), column);
         assert!(!values.is_empty());
         assert!(values.iter().all(|v| v.is_nan()), "{column}: {values:?}");

@@ -17,12 +17,13 @@ pub struct StepStats {
     pub density_error: f64,
     pub penetrations: usize,
     pub disorder: f64,
+    pub compression: f64,
 }
 
 pub const FILE_NAME: &str = "stats.csv";
 
 pub const HEADER: &str =
-    "step,time,dt,ppe_iterations,ppe_residual,max_speed,kinetic_energy,density_error,penetrations,wall_seconds,disorder";
+    "step,time,dt,ppe_iterations,ppe_residual,max_speed,kinetic_energy,density_error,penetrations,wall_seconds,disorder,compression";
 
 pub struct StatsWriter(CsvWriter);
 
@@ -39,7 +40,7 @@ impl StatsWriter {
     /// One row; `wall_seconds` is the wall-clock time since the run started.
     pub fn row(&mut self, s: &StepStats, wall_seconds: f64) -> Result<(), OutputError> {
         self.0.line(format_args!(
-            "{},{:e},{:e},{},{:e},{:e},{:e},{:e},{},{:.3},{:e}",
+            "{},{:e},{:e},{},{:e},{:e},{:e},{:e},{},{:.3},{:e},{:e}",
             s.step,
             s.time,
             s.dt,
@@ -50,7 +51,8 @@ impl StatsWriter {
             s.density_error,
             s.penetrations,
             wall_seconds,
-            s.disorder
+            s.disorder,
+            s.compression
         ))
     }
 

@@ -1,5 +1,6 @@
-//! What a step measured, for `stats.csv`: the density error and the particle disorder over
-//! the fluid with a full kernel support, and the largest speed and the kinetic energy.
+//! What a step measured, for `stats.csv`: the density error, the compression and the particle
+//! disorder over the fluid with a full kernel support, and the largest speed and the kinetic
+//! energy.
 
 use super::{Stage, StepSettings};
 use crate::math::reduce;
@@ -9,33 +10,58 @@ pub const NAME: &str = "diagnostics";
 
 pub struct Diagnostics;
 
-/// Two measures over the fluid particles with no free surface in reach (`full`, where the
-/// summation density is not truncated), in one pass:
-/// - the density error, mean |ρ/ρ0 − 1|;
-/// - the particle disorder, the coefficient of variation (standard deviation over mean) of
-///   the distance from each particle to its nearest neighbour (`nearest`, from the free surface's
-///   walk): zero on a lattice, a few per cent when particles stay well spread, growing as they
-///   cluster into lines and gaps (tensile instability, no shifting).
-///
-/// NaN for both where no particle has a full support (nothing measured, not a zero error).
+/// What the fluid particles with no free surface in reach (where the summation density is
+/// not truncated) measure.
+#[derive(Clone, Copy, Debug)]
+pub struct FullSupport {
+    /// The density error, mean |ρ/ρ0 − 1|: compression and the summation density's scatter
+    /// about its mean together.
+    pub density_error: f64,
+    /// The compression, mean (ρ/ρ0 − 1): the water's volume against its rest volume, with the
+    /// scatter averaged out (docs/accuracy.md, "Smoothing length").
+    pub compression: f64,
+    /// The particle disorder, the coefficient of variation (standard deviation over mean) of
+    /// the distance from each particle to its nearest neighbour: zero on a lattice, a few per
+    /// cent when particles stay well spread, growing as they cluster into lines and gaps
+    /// (tensile instability, no shifting).
+    pub disorder: f64,
+}
+
+/// `FullSupport` over the fluid particles flagged `full`, in one pass, with `nearest` the
+/// distance from each to its nearest neighbour (from the free surface's walk). NaN throughout
+/// where no particle has a full support (nothing measured, not a zero error).
 pub fn full_support_statistics<const D: usize>(
     p: &Particles<D>,
     full: &[bool],
     nearest: &[f64],
-) -> (f64, f64) {
-    let [count, density, distance, square] = reduce::sums(full.len(), |i| {
+) -> FullSupport {
+    let [count, error, excess, distance, square] = reduce::sums(full.len(), |i| {
         if !full[i] {
-            return [0.0; 4];
+            return [0.0; 5];
         }
-        let error = (p.density[i] / p.rest_density[i] - 1.0).abs();
-        [1.0, error, nearest[i], nearest[i] * nearest[i]]
+        let excess = p.density[i] / p.rest_density[i] - 1.0;
+        [
+            1.0,
+            excess.abs(),
+            excess,
+            nearest[i],
+            nearest[i] * nearest[i],
+        ]
     });
     if count == 0.0 {
-        return (f64::NAN, f64::NAN);
+        return FullSupport {
+            density_error: f64::NAN,
+            compression: f64::NAN,
+            disorder: f64::NAN,
+        };
     }
     let mean = distance / count;
     let variance = (square / count - mean * mean).max(0.0);
-    (density / count, variance.sqrt() / mean)
+    FullSupport {
+        density_error: error / count,
+        compression: excess / count,
+        disorder: variance.sqrt() / mean,
+    }
 }
 
 /// The largest fluid speed and the fluid's kinetic energy.
@@ -57,6 +83,7 @@ impl<const D: usize> Stage<D> for Diagnostics {
     }
 
     fn describe(&self, _: &StepSettings<D>) -> String {
-        "max speed, kinetic energy, density error, disorder, penetrations → stats.csv".into()
+        "max speed, kinetic energy, density error, compression, disorder, penetrations → stats.csv"
+            .into()
     }
 }

@@ -127,10 +127,9 @@ pub struct StepReport {
     /// Whether the step landed on the target time it was asked to go towards.
     pub lands_on_target: bool,
     pub solve: SolveInfo,
-    /// Mean |ρ/ρ0 − 1| over fluid particles with no free surface in reach.
-    pub density_error: f64,
-    /// Spread of the nearest-neighbour distance over the same particles (`disorder`).
-    pub disorder: f64,
+    /// Density error, compression and disorder over the fluid particles with no free surface
+    /// in reach.
+    pub full_support: diagnostics::FullSupport,
     /// Fluid particles the advection put beyond a wall face, before the contact put them back.
     pub penetrations: usize,
     /// Largest fluid speed after the step.
@@ -348,7 +347,7 @@ impl<const D: usize> Step<D> {
         let fluid = self.grid().range_of(Kind::Fluid);
         debug_assert_eq!(fluid.start, 0, "the fluid comes first in the sorted order");
         let nf = fluid.end;
-        let (solve, density_error, disorder, shift) = {
+        let (solve, full_support, shift) = {
             let nb = Neighbours::new(self.cell_list.grid(), &p.pos, self.kernel);
             // The time-step limit is in no stage (`isph bench`'s "other").
             laps.skip();
@@ -480,7 +479,7 @@ impl<const D: usize> Step<D> {
             }
             // Into the particles: uⁿ⁺¹ (the bodies' rigid).
             copy_vector(velocity, &mut p.vel);
-            let (density_error, disorder) = diagnostics::full_support_statistics(
+            let full_support = diagnostics::full_support_statistics(
                 p,
                 surface.full_support,
                 self.free_surface.nearest(),
@@ -546,7 +545,7 @@ impl<const D: usize> Step<D> {
                 }
                 None => density_shift,
             };
-            (solve, density_error, disorder, shift)
+            (solve, full_support, shift)
         };
         // Into the particles: r (and u where the contact puts a particle back).
         let penetrations = self
@@ -574,8 +573,7 @@ impl<const D: usize> Step<D> {
             length,
             lands_on_target,
             solve,
-            density_error,
-            disorder,
+            full_support,
             penetrations,
             max_speed,
             kinetic_energy,
