@@ -203,7 +203,7 @@ fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize, S
 /// test, and 0.04, 0.03, 0.025 s) at the defaults (CFL 0.4, α = 0.3): the worst step is
 /// 0.70–0.80% over four, the mean over the steps 0.37–0.39%; at α = 0.1 the bound was broken on
 /// three of four (0.89–1.37%) (docs/stabilisation.md, "The violent impact over its
-/// trajectories").
+/// trajectories"). The test's draw on 2026-12-07 (with the wall layer): 0.74% and 0.34%.
 #[test]
 fn violent_impact_keeps_density_and_volume() {
     let (dir, frames, scene) = violent_impact(40.0, "", "impact");
@@ -219,7 +219,8 @@ fn violent_impact_keeps_density_and_volume() {
     // Volume: every particle stands for dx² of water at ρ0, none is lost, and the bulk's
     // density, the mean of ρ/ρ0 − 1 (`compression`; the density error above also counts the
     // summation's scatter about it), stays within 0.2% of ρ0 on average over the steps
-    // (measured −0.096% on average, 0.41% at the largest step).
+    // (measured: |compression| 0.096% on average, all of it expansion, 0.41% at the largest
+    // step).
     assert_eq!(fluid_count(out, frames - 1), fluid_count(out, 0));
     let compression: Vec<f64> = stats_column(out, "compression")
         .into_iter()
@@ -255,7 +256,12 @@ fn without_the_density_correction_the_compression_column_reads_the_volume_drift(
         .filter(|(_, c)| !c.is_nan())
         .map(|(k, c)| (k, c.abs()))
         .fold((0, 0.0), |best, x| if x.1 > best.1 { x } else { best });
-    assert!(drift > 0.02, "the volume drifted by {drift} at most");
+    // Expanded: the column is negative where the water's volume exceeds its rest volume.
+    assert!(
+        compression[k] < -0.02,
+        "the volume drifted by {} at most",
+        compression[k]
+    );
     assert!(
         drift >= 0.9 * error[k],
         "compression {} against density error {} at the largest drift",

@@ -17,8 +17,9 @@ pub struct FullSupport {
     /// The density error, mean |ρ/ρ0 − 1|: compression and the summation density's scatter
     /// about its mean together.
     pub density_error: f64,
-    /// The compression, mean (ρ/ρ0 − 1): the water's volume against its rest volume, with the
-    /// scatter averaged out (docs/accuracy.md, "Smoothing length").
+    /// The compression, mean (ρ/ρ0 − 1), signed: positive where the water is compressed
+    /// (its volume below the rest volume), negative where it has expanded; the scatter
+    /// averages out (docs/accuracy.md, "Smoothing length").
     pub compression: f64,
     /// The particle disorder, the coefficient of variation (standard deviation over mean) of
     /// the distance from each particle to its nearest neighbour: zero on a lattice, a few per

@@ -347,7 +347,7 @@ impl<const D: usize> Step<D> {
         let fluid = self.grid().range_of(Kind::Fluid);
         debug_assert_eq!(fluid.start, 0, "the fluid comes first in the sorted order");
         let nf = fluid.end;
-        let (solve, full_support, shift) = {
+        let (solve, measured, shift) = {
             let nb = Neighbours::new(self.cell_list.grid(), &p.pos, self.kernel);
             // The time-step limit is in no stage (`isph bench`'s "other").
             laps.skip();
@@ -479,7 +479,7 @@ impl<const D: usize> Step<D> {
             }
             // Into the particles: uⁿ⁺¹ (the bodies' rigid).
             copy_vector(velocity, &mut p.vel);
-            let full_support = diagnostics::full_support_statistics(
+            let measured = diagnostics::full_support_statistics(
                 p,
                 surface.full_support,
                 self.free_surface.nearest(),
@@ -545,7 +545,7 @@ impl<const D: usize> Step<D> {
                 }
                 None => density_shift,
             };
-            (solve, full_support, shift)
+            (solve, measured, shift)
         };
         // Into the particles: r (and u where the contact puts a particle back).
         let penetrations = self
@@ -573,7 +573,7 @@ impl<const D: usize> Step<D> {
             length,
             lands_on_target,
             solve,
-            full_support,
+            full_support: measured,
             penetrations,
             max_speed,
             kinetic_energy,
