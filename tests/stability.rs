@@ -203,7 +203,8 @@ fn violent_impact(per_width: f64, extra: &str, name: &str) -> (TempDir, usize, S
 /// test, and 0.04, 0.03, 0.025 s) at the defaults (CFL 0.4, α = 0.3): the worst step is
 /// 0.70–0.80% over four, the mean over the steps 0.37–0.39%; at α = 0.1 the bound was broken on
 /// three of four (0.89–1.37%) (docs/stabilisation.md, "The violent impact over its
-/// trajectories"). The test's draw on 2026-12-07 (with the wall layer): 0.74% and 0.34%.
+/// trajectories"). With the LES's wall layer (2026-12-07) the four read 0.74–0.80% and
+/// 0.34–0.35%, the test's draw 0.74% and 0.34%.
 #[test]
 fn violent_impact_keeps_density_and_volume() {
     let (dir, frames, scene) = violent_impact(40.0, "", "impact");
