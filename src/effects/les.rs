@@ -26,6 +26,7 @@
 //! Cs and whether the wall function applies are the scene's `[effects.les]` (`LesSettings`).
 
 use crate::boundary::ghosts::Face;
+use crate::math::vector::{dot, norm};
 use crate::particles::Particles;
 
 /// von Kármán constant κ.
@@ -74,7 +75,7 @@ pub fn wall_shear<const D: usize>(
         return [0.0; D];
     };
     let u_t = velocity_along(p, n, i);
-    let speed = u_t.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let speed = norm(u_t);
     let nu = p.viscosity[i];
     if speed == 0.0 || nu == 0.0 {
         return [0.0; D];
@@ -91,11 +92,7 @@ pub fn wall_shear<const D: usize>(
 /// carries the wall's shear stress ρ u_τ² across the layer.
 pub fn wall_layer_viscosity<const D: usize>(p: &Particles<D>, face: Face<D>, i: usize) -> f64 {
     let y = face.distance;
-    let speed = velocity_along(p, face.normal, i)
-        .iter()
-        .map(|x| x * x)
-        .sum::<f64>()
-        .sqrt();
+    let speed = norm(velocity_along(p, face.normal, i));
     let nu = p.viscosity[i];
     if speed == 0.0 || nu == 0.0 {
         return 0.0;
@@ -106,7 +103,7 @@ pub fn wall_layer_viscosity<const D: usize>(p: &Particles<D>, face: Face<D>, i: 
 /// The velocity of fluid particle i along a wall of normal `n`: its normal part taken out.
 fn velocity_along<const D: usize>(p: &Particles<D>, n: [f64; D], i: usize) -> [f64; D] {
     let u = p.velocity(i);
-    let u_n: f64 = (0..D).map(|d| u[d] * n[d]).sum();
+    let u_n = dot(u, n);
     std::array::from_fn(|d| u[d] - u_n * n[d])
 }
 
