@@ -33,8 +33,9 @@ fn order(coarse: f64, fine: f64) -> f64 {
 }
 
 /// Measured (release, t = 1 s, from the perturbed lattice of the shipped scene): decay rate
-/// 5.4% off at dx = L/20, 0.52% at L/40 (0.03% at L/80); velocity L2 error 5.1% and 0.95%,
-/// order 2.4 (0.26% at L/80). With the projection's divergence at the start of the drift, as
+/// 5.4% off at dx = L/20, 0.50% at L/40 (0.03% at L/80); velocity L2 error 5.1% and 1.14%,
+/// order 2.2 (0.29% at L/80; 0.95% at L/40 while the last two steps before a frame were halves:
+/// docs/accuracy.md, "What a frame reads of the last steps"). With the projection's divergence at the start of the drift, as
 /// Eq. (6) prints it, the decay rate was 8.7% and 4.3% too fast and the L2 order 1.2 (at CFL
 /// 0.24; docs/accuracy.md, "The time lag of the projection"). With Euler's viscous step of
 /// Eq. (26), 3.1% and 0.07% (4.1% and 0.89% L2): the kernel's smoothing of the Laplacian then
@@ -51,9 +52,9 @@ fn taylor_green_decays_at_the_analytic_rate_and_converges() {
 }
 
 /// The shipped vortex with the Wendland C2 kernel at its default h/dx = 1.8 (docs/accuracy.md,
-/// "Kernels"). Measured (release, t = 1 s): decay rate 6.7% off at L/20, 0.26% at L/40; velocity
-/// L2 error 6.0% and 1.1%, order 2.4 (0.53% at L/80). At L/80 less accurate than the quintic at
-/// h/dx = 1.2 (0.03% and 0.26%).
+/// "Kernels"). Measured (release, t = 1 s): decay rate 6.5% off at L/20, 0.24% at L/40; velocity
+/// L2 error 5.9% and 1.4%, order 2.1 (0.55% at L/80). At L/80 less accurate than the quintic at
+/// h/dx = 1.2 (0.03% and 0.29%).
 #[test]
 fn taylor_green_converges_with_the_wendland_kernel() {
     taylor_green_converges(KernelKind::WendlandC2, 0.007, 0.02);
