@@ -34,13 +34,13 @@ fn order(coarse: f64, fine: f64) -> f64 {
 
 /// Measured (release, t = 1 s, from the perturbed lattice of the shipped scene): decay rate
 /// 5.4% off at dx = L/20, 0.50% at L/40 (0.03% at L/80); velocity L2 error 5.1% and 1.14%,
-/// order 2.2 (0.29% at L/80; 0.95% at L/40 while the last two steps before a frame were halves:
-/// docs/accuracy.md, "What a frame reads of the last steps"). With the projection's divergence at the start of the drift, as
-/// Eq. (6) prints it, the decay rate was 8.7% and 4.3% too fast and the L2 order 1.2 (at CFL
-/// 0.24; docs/accuracy.md, "The time lag of the projection"). With Euler's viscous step of
-/// Eq. (26), 3.1% and 0.07% (4.1% and 0.89% L2): the kernel's smoothing of the Laplacian then
-/// offset the shifting's dissipation, first order in Δt, which the L/20 bound of 6% now holds
-/// (docs/accuracy.md, "The viscous operator").
+/// order 2.2 (0.29% at L/80; 0.95% at L/40 while the last two steps before a frame were
+/// halves: docs/accuracy.md, "What a frame reads of the last steps"). With the projection's
+/// divergence at the start of the drift, as Eq. (6) prints it, the decay rate was 8.7% and 4.3%
+/// too fast and the L2 order 1.2 (at CFL 0.24; docs/accuracy.md, "The time lag of the
+/// projection"). With Euler's viscous step of Eq. (26), 3.1% and 0.07% (4.1% and 0.89% L2): the
+/// kernel's smoothing of the Laplacian then offset the shifting's dissipation, first order in
+/// Δt, which the L/20 bound of 6% now holds (docs/accuracy.md, "The viscous operator").
 #[test]
 fn taylor_green_decays_at_the_analytic_rate_and_converges() {
     let coarse = taylor_green_converges(KernelKind::Quintic, 0.01, 0.015);
@@ -64,9 +64,9 @@ fn taylor_green_converges_with_the_wendland_kernel() {
 /// rate within `decay` and the velocity L2 error within `l2`, which falls from L/20 at an order
 /// above 1.5. Read at the midpoint of each particle's last drift, where the projection made the
 /// field divergence-free, the L2 error at L/40 is below 0.6% and falls at an order above 2.5
-/// (measured: quintic 3.95% → 0.38%, order 3.4; Wendland C2 4.86% → 0.22%, order 4.5): at the
-/// frame's positions a third of the error or less is the flow's, the rest the half drift by
-/// which the positions lead the velocities (docs/accuracy.md, "What a frame reads of the last
+/// (measured: quintic 3.95% → 0.38%, order 3.4; Wendland C2 4.86% → 0.22%, order 4.5): at L/40
+/// a third of the frame's reading is the flow's, the rest the half drift by which the positions
+/// lead the velocities (docs/accuracy.md, "What a frame reads of the last
 /// steps"). Returns the L/20 measure.
 fn taylor_green_converges(kernel: KernelKind, decay: f64, l2: f64) -> Measured {
     let at = |spacing| {
