@@ -66,8 +66,8 @@ fn taylor_green_converges_with_the_wendland_kernel() {
 /// field divergence-free, the L2 error at L/40 is below 0.6% and falls at an order above 2.5
 /// (measured: quintic 3.95% → 0.38%, order 3.4; Wendland C2 4.86% → 0.22%, order 4.5): at L/40
 /// a third of the frame's reading is the flow's, the rest the half drift by which the positions
-/// lead the velocities (docs/accuracy.md, "What a frame reads of the last
-/// steps"). Returns the L/20 measure.
+/// lead the velocities (docs/accuracy.md, "What a frame reads of the last steps"). Returns the
+/// L/20 measure.
 fn taylor_green_converges(kernel: KernelKind, decay: f64, l2: f64) -> Measured {
     let at = |spacing| {
         measured_with(
