@@ -254,21 +254,53 @@ impl<const D: usize> Simulation<D> {
         }
     }
 
-    /// The values of `probes` as the particles stand, in the order of their columns in
+    /// Where the particles stand at `time`, what a frame, a probe and a surface built during a
+    /// run read. The advection moves the fluid over the whole step with the step's velocity,
+    /// rⁿ⁺¹ = rⁿ + Δt uⁿ⁺¹ + δr (Eq. 8), while uⁿ⁺¹ is the velocity of the step's end time (in
+    /// free fall from rest uⁿ = g tⁿ exactly) and the projection made it divergence-free at the
+    /// midpoint of that drift (`ppe::divergence_source`): the positions lead the velocities by
+    /// half a drift (in free fall rⁿ = g tⁿ²/2 + (Δt/2) uⁿ), and the fluid stands at
+    /// rⁿ⁺¹ − (Δt/2) uⁿ⁺¹, the midpoint of the last drift (docs/accuracy.md, "Where a frame's
+    /// particles stand"). The walls stand where the container is, and a body's particles where
+    /// its pose puts them, whose centre drifts by the trapezoid, exact in free fall. Before the
+    /// first step the particles stand where they are.
+    pub fn present_positions(&self) -> [Vec<f64>; D] {
+        let p = &self.particles;
+        let half_drift = 0.5 * self.last_dt.unwrap_or(0.0);
+        let mut pos: [Vec<f64>; D] = std::array::from_fn(|d| {
+            (0..p.len())
+                .map(|i| {
+                    let back = if p.is_fluid(i) {
+                        half_drift * p.vel[d][i]
+                    } else {
+                        0.0
+                    };
+                    p.pos[d][i] - back
+                })
+                .collect()
+        });
+        self.stepper.grid().wrap(&mut pos);
+        pos
+    }
+
+    /// The values of `probes` where the particles stand at `time` (`present_positions`), in the
+    /// order of their columns in
     /// `probes.csv` (`Probe::columns`): the Shepard interpolation of the fluid, or a gauge's
     /// surface height on its vertical line across `container` (`sph::probe`; NaN where no water
     /// is under it).
     pub fn probe_values(&self, probes: &[Probe], container: &Aabb) -> Vec<f64> {
+        let pos = self.present_positions();
         let kernel = self.kernel();
         let spacing = self.stepper.settings.spacing;
         let periods = &self.periods;
         let sample = |point| {
             let full = probe::full_fraction(&kernel, spacing, container, periods, point);
             let wet = probe::SURFACE_FRACTION * full;
-            probe::sample(&self.particles, &kernel, periods, point, wet)
+            probe::sample(&self.particles, &pos, &kernel, periods, point, wet)
         };
         let gauge = |point| {
-            probe::surface_height(&self.particles, &kernel, periods, point, container, spacing)
+            let p = &self.particles;
+            probe::surface_height(p, &pos, &kernel, periods, point, container, spacing)
                 .unwrap_or(f64::NAN)
         };
         let mut values = Vec::new();

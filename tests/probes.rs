@@ -28,13 +28,27 @@ fn lattice_with(u: impl Fn([f64; 2]) -> [f64; 2], p: impl Fn([f64; 2]) -> f64) -
 fn a_uniform_flow_is_read_exactly_and_no_fluid_reads_zero() {
     let l = lattice_with(|_| [0.7, -0.3], |_| 1234.5);
     for point in [[0.0, 0.0], [0.0113, -0.2], [0.49, 0.49]] {
-        let s = sample(&l.particles, &l.kernel, &[None, None], point, 0.0);
+        let s = sample(
+            &l.particles,
+            &l.particles.pos,
+            &l.kernel,
+            &[None, None],
+            point,
+            0.0,
+        );
         assert!((s.velocity[0] - 0.7).abs() < 1e-13, "{point:?}: {s:?}");
         assert!((s.velocity[1] + 0.3).abs() < 1e-13, "{point:?}: {s:?}");
         assert!((s.pressure - 1234.5).abs() < 1e-9, "{point:?}: {s:?}");
     }
     // The lattice ends at 0.475 m; the support is 3h = 0.09 m.
-    let far = sample(&l.particles, &l.kernel, &[None, None], [0.6, 0.0], 0.0);
+    let far = sample(
+        &l.particles,
+        &l.particles.pos,
+        &l.kernel,
+        &[None, None],
+        [0.6, 0.0],
+        0.0,
+    );
     assert_eq!((far.pressure, far.velocity), (0.0, [0.0, 0.0]));
 }
 
@@ -62,7 +76,14 @@ fn taylor_green_reading_error(n: i64) -> f64 {
         [0.0, 0.0],
         [0.31, 0.33],
     ] {
-        let s = sample(&l.particles, &l.kernel, &[None, None], point, 0.0);
+        let s = sample(
+            &l.particles,
+            &l.particles.pos,
+            &l.kernel,
+            &[None, None],
+            point,
+            0.0,
+        );
         let exact = field(point);
         for d in 0..2 {
             worst = worst.max((s.velocity[d] - exact[d]).abs());
@@ -175,6 +196,7 @@ fn gauge_reading(
     };
     surface_height(
         &l.particles,
+        &l.particles.pos,
         &l.kernel,
         &[None, None],
         [x, 0.0],
@@ -261,7 +283,15 @@ fn a_probe_reads_only_where_water_covers_it() {
     l.particles.pressure.iter_mut().for_each(|p| *p = 1234.5);
     let read = |y: f64| {
         let wet = SURFACE_FRACTION * full([0.0, y]);
-        sample(&l.particles, &l.kernel, &[None, None], [0.0, y], wet).pressure
+        sample(
+            &l.particles,
+            &l.particles.pos,
+            &l.kernel,
+            &[None, None],
+            [0.0, y],
+            wet,
+        )
+        .pressure
     };
     assert!((read(5.2 * dx) - 1234.5).abs() < 1e-9, "under the surface");
     assert_eq!(read(5.8 * dx), 0.0, "over the surface");
@@ -270,6 +300,7 @@ fn a_probe_reads_only_where_water_covers_it() {
     let on_face = SURFACE_FRACTION * full([0.0, floor]);
     let s = sample(
         &l.particles,
+        &l.particles.pos,
         &l.kernel,
         &[None, None],
         [0.0, floor],

@@ -121,16 +121,18 @@ impl FrameWriter {
             .map_err(err)
     }
 
-    /// Appends frame number `index` and flushes the file.
+    /// Appends frame number `index`, the particles of `p` standing at `pos`, and flushes the
+    /// file.
     pub fn write<const D: usize>(
         &mut self,
         index: usize,
         p: &Particles<D>,
+        pos: &[Vec<f64>; D],
         time: f64,
         step: u64,
     ) -> Result<FrameInfo, OutputError> {
         let group = group_name(index);
-        self.write_group(&group, p, time, step)
+        self.write_group(&group, p, pos, time, step)
             .map_err(|source| OutputError::Hdf5 {
                 path: self.path.clone(),
                 source,
@@ -147,6 +149,7 @@ impl FrameWriter {
         &self,
         name: &str,
         p: &Particles<D>,
+        pos: &[Vec<f64>; D],
         time: f64,
         step: u64,
     ) -> hdf5::Result<()> {
@@ -163,7 +166,7 @@ impl FrameWriter {
         g.new_dataset::<f64>()
             .shape((n, 3))
             .create("position")?
-            .write_raw(&vector(&p.pos))?;
+            .write_raw(&vector(pos))?;
         g.new_dataset::<f64>()
             .shape((n, 3))
             .create("velocity")?

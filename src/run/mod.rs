@@ -323,9 +323,10 @@ impl<'a, const D: usize> Driver<'a, D> {
         }
         let o = &mut self.output;
         let index = o.frames.len();
+        let (p, pos) = (&self.sim.particles, self.sim.present_positions());
         let frame = o
             .frames_out
-            .write(index, &self.sim.particles, self.sim.time, self.sim.step)?;
+            .write(index, p, &pos, self.sim.time, self.sim.step)?;
         o.frames.push(frame);
         xdmf::write(&o.dir, &o.frames)?;
         if let Some(bodies) = &mut o.bodies {
@@ -333,7 +334,7 @@ impl<'a, const D: usize> Driver<'a, D> {
             bodies.flush()?;
         }
         if let Some((writer, settings)) = &mut o.surfaces {
-            let points = output::fluid_points(&self.sim.particles, self.scene.spacing);
+            let points = output::fluid_points(p, &pos, self.scene.spacing);
             // A surface that cannot be built (the fluid spread over more cubes than allowed)
             // is not worth a run that may have days behind it: the frame goes without one.
             match surface::reconstruct(&points, settings) {

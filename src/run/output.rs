@@ -24,9 +24,13 @@ pub(crate) struct Output {
     pub bodies: Option<BodiesWriter>,
 }
 
-/// The fluid particles of `p` in id order, as a frame lists them: the surface built during a
-/// run is the one `isph surface` builds from its frame.
-pub(crate) fn fluid_points<const D: usize>(p: &Particles<D>, spacing: f64) -> Points {
+/// The fluid particles of `p` standing at `pos`, in id order, as a frame lists them: the
+/// surface built during a run is the one `isph surface` builds from its frame.
+pub(crate) fn fluid_points<const D: usize>(
+    p: &Particles<D>,
+    pos: &[Vec<f64>; D],
+    spacing: f64,
+) -> Points {
     let fluid: Vec<usize> = p
         .index_by_id()
         .into_iter()
@@ -39,7 +43,7 @@ pub(crate) fn fluid_points<const D: usize>(p: &Particles<D>, spacing: f64) -> Po
     Points {
         dimensions: D,
         spacing,
-        position: fluid.iter().map(|&i| triple(&p.pos, i)).collect(),
+        position: fluid.iter().map(|&i| triple(pos, i)).collect(),
         velocity: fluid.iter().map(|&i| triple(&p.vel, i)).collect(),
     }
 }

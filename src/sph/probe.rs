@@ -40,10 +40,12 @@ pub struct Sample<const D: usize> {
 }
 
 /// The Shepard interpolation of the fluid's pressure and velocity at `x`, where its fluid
-/// fraction is at least `wet` (zero elsewhere). `periods[d]` is the length of the box along a
-/// periodic axis d: distances along it are to the nearest image.
+/// fraction is at least `wet` (zero elsewhere), the particles of `p` standing at `pos`.
+/// `periods[d]` is the length of the box along a periodic axis d: distances along it are to
+/// the nearest image.
 pub fn sample<const D: usize>(
     p: &Particles<D>,
+    pos: &[Vec<f64>; D],
     kernel: &Kernel<D>,
     periods: &[Option<f64>; D],
     x: [f64; D],
@@ -58,7 +60,7 @@ pub fn sample<const D: usize>(
         }
         let mut r2 = 0.0;
         for d in 0..D {
-            let mut dx = x[d] - p.pos[d][j];
+            let mut dx = x[d] - pos[d][j];
             if let Some(period) = periods[d] {
                 dx -= period * (dx / period).round();
             }
@@ -129,9 +131,10 @@ const GAUGE_SAMPLE: f64 = 0.25;
 /// water, not the water under it), the container's top where c stays above it up to there,
 /// none where c stays below it on the whole line (no water under the gauge). c is sampled every
 /// quarter `spacing` down from the top, and the first interval that crosses is bisected to
-/// round-off. `periods` as for `sample`.
+/// round-off. `pos` and `periods` as for `sample`.
 pub fn surface_height<const D: usize>(
     p: &Particles<D>,
+    pos: &[Vec<f64>; D],
     kernel: &Kernel<D>,
     periods: &[Option<f64>; D],
     x: [f64; D],
@@ -146,14 +149,14 @@ pub fn surface_height<const D: usize>(
         .filter_map(|j| {
             let mut r2 = 0.0;
             for d in 0..up {
-                let mut dx = x[d] - p.pos[d][j];
+                let mut dx = x[d] - pos[d][j];
                 if let Some(period) = periods[d] {
                     dx -= period * (dx / period).round();
                 }
                 r2 += dx * dx;
             }
             let volume = p.mass[j] / p.rest_density[j] * kernel.density_scale();
-            (r2 < support * support).then_some((r2, p.pos[up][j], volume))
+            (r2 < support * support).then_some((r2, pos[up][j], volume))
         })
         .collect();
     let fraction = |z: f64| -> f64 {
