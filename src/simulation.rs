@@ -259,11 +259,12 @@ impl<const D: usize> Simulation<D> {
     /// rⁿ⁺¹ = rⁿ + Δt uⁿ⁺¹ + δr (Eq. 8), while uⁿ⁺¹ is the velocity of the step's end time (in
     /// free fall from rest uⁿ = g tⁿ exactly) and the projection made it divergence-free at the
     /// midpoint of that drift (`ppe::divergence_source`): the positions lead the velocities by
-    /// half a drift (in free fall rⁿ = g tⁿ²/2 + (Δt/2) uⁿ), and the fluid stands at
-    /// rⁿ⁺¹ − (Δt/2) uⁿ⁺¹, the midpoint of the last drift (docs/accuracy.md, "Where a frame's
-    /// particles stand"). The walls stand where the container is, and a body's particles where
-    /// its pose puts them, whose centre drifts by the trapezoid, exact in free fall. Before the
-    /// first step the particles stand where they are.
+    /// half a drift (in free fall at a constant step rⁿ = g tⁿ²/2 + (Δt/2) uⁿ), and the fluid
+    /// stands at rⁿ⁺¹ − (Δt/2) uⁿ⁺¹, the midpoint of the last drift (docs/accuracy.md, "Where a
+    /// frame's particles stand"). The walls stand where the container is, and a body's
+    /// particles where its pose puts them, whose centre drifts by the trapezoid, exact in free
+    /// fall. Before the first step the particles stand where they are. The checkpoint keeps
+    /// the advection's positions, from which the next step starts.
     pub fn present_positions(&self) -> [Vec<f64>; D] {
         let p = &self.particles;
         let half_drift = 0.5 * self.last_dt.unwrap_or(0.0);
@@ -284,10 +285,9 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// The values of `probes` where the particles stand at `time` (`present_positions`), in the
-    /// order of their columns in
-    /// `probes.csv` (`Probe::columns`): the Shepard interpolation of the fluid, or a gauge's
-    /// surface height on its vertical line across `container` (`sph::probe`; NaN where no water
-    /// is under it).
+    /// order of their columns in `probes.csv` (`Probe::columns`): the Shepard interpolation of
+    /// the fluid, or a gauge's surface height on its vertical line across `container`
+    /// (`sph::probe`; NaN where no water is under it).
     pub fn probe_values(&self, probes: &[Probe], container: &Aabb) -> Vec<f64> {
         let pos = self.present_positions();
         let kernel = self.kernel();
