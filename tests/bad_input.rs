@@ -166,6 +166,16 @@ fn each_bad_scene_is_refused_with_its_key_and_line() {
             &["line 5", "TOML parse error", "expected `]`"],
         ),
         (
+            "gravity = [0.0, -9.81]",
+            "",
+            &["line 1", "missing field `gravity`", "in the section `[simulation]`"],
+        ),
+        (
+            "density = 1000.0",
+            "",
+            &["line 8", "missing field `density`", "in the section `[[fluid]]`"],
+        ),
+        (
             "max = [0.4, 0.3]",
             "max = [0.4, 0.3]\n\n[walls]\nghost_pressure = \"sticky\"",
             &[

@@ -234,7 +234,14 @@ pub fn syntax_message(text: &str, e: &toml::de::Error) -> String {
                 .chars()
                 .count()
                 + 1;
-            format!("TOML parse error at line {line}, column {column}: {what}")
+            // A missing key is reported at the header of the section that lacks it.
+            let header = text[span.start..].lines().next().unwrap_or("").trim();
+            let section = if header.starts_with('[') && what.starts_with("missing field") {
+                format!(" in the section `{header}` that starts there")
+            } else {
+                String::new()
+            };
+            format!("TOML parse error at line {line}, column {column}: {what}{section}")
         }
         None => format!("TOML parse error: {what}"),
     }
