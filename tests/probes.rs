@@ -8,7 +8,7 @@ use crate::common::{run_scene, scene_from_text, Lattice, TempDir};
 use isph::io::probes;
 use isph::math::kernel::{Kernel, KernelKind};
 use isph::scene::Aabb;
-use isph::sph::probe::{full_fraction, sample, surface_height, SURFACE_FRACTION};
+use isph::sph::probe::{full_fraction, sample, surface_height, Sample, SURFACE_FRACTION};
 use std::f64::consts::PI;
 
 /// The particles of a 40 × 40 lattice (dx = 0.025 m) with the velocity `u` and pressure `p`.
@@ -24,31 +24,29 @@ fn lattice_with(u: impl Fn([f64; 2]) -> [f64; 2], p: impl Fn([f64; 2]) -> f64) -
     l
 }
 
+/// The probe's reading at `point` of the lattice's particles where they stand, in an open plane.
+fn sample_at(l: &Lattice<2>, point: [f64; 2], wet: f64) -> Sample<2> {
+    sample(
+        &l.particles,
+        &l.particles.pos,
+        &l.kernel,
+        &[None, None],
+        point,
+        wet,
+    )
+}
+
 #[test]
 fn a_uniform_flow_is_read_exactly_and_no_fluid_reads_zero() {
     let l = lattice_with(|_| [0.7, -0.3], |_| 1234.5);
     for point in [[0.0, 0.0], [0.0113, -0.2], [0.49, 0.49]] {
-        let s = sample(
-            &l.particles,
-            &l.particles.pos,
-            &l.kernel,
-            &[None, None],
-            point,
-            0.0,
-        );
+        let s = sample_at(&l, point, 0.0);
         assert!((s.velocity[0] - 0.7).abs() < 1e-13, "{point:?}: {s:?}");
         assert!((s.velocity[1] + 0.3).abs() < 1e-13, "{point:?}: {s:?}");
         assert!((s.pressure - 1234.5).abs() < 1e-9, "{point:?}: {s:?}");
     }
     // The lattice ends at 0.475 m; the support is 3h = 0.09 m.
-    let far = sample(
-        &l.particles,
-        &l.particles.pos,
-        &l.kernel,
-        &[None, None],
-        [0.6, 0.0],
-        0.0,
-    );
+    let far = sample_at(&l, [0.6, 0.0], 0.0);
     assert_eq!((far.pressure, far.velocity), (0.0, [0.0, 0.0]));
 }
 
@@ -76,14 +74,7 @@ fn taylor_green_reading_error(n: i64) -> f64 {
         [0.0, 0.0],
         [0.31, 0.33],
     ] {
-        let s = sample(
-            &l.particles,
-            &l.particles.pos,
-            &l.kernel,
-            &[None, None],
-            point,
-            0.0,
-        );
+        let s = sample_at(&l, point, 0.0);
         let exact = field(point);
         for d in 0..2 {
             worst = worst.max((s.velocity[d] - exact[d]).abs());
@@ -283,28 +274,13 @@ fn a_probe_reads_only_where_water_covers_it() {
     l.particles.pressure.iter_mut().for_each(|p| *p = 1234.5);
     let read = |y: f64| {
         let wet = SURFACE_FRACTION * full([0.0, y]);
-        sample(
-            &l.particles,
-            &l.particles.pos,
-            &l.kernel,
-            &[None, None],
-            [0.0, y],
-            wet,
-        )
-        .pressure
+        sample_at(&l, [0.0, y], wet).pressure
     };
     assert!((read(5.2 * dx) - 1234.5).abs() < 1e-9, "under the surface");
     assert_eq!(read(5.8 * dx), 0.0, "over the surface");
     // The same water on a wall's face: the floor of the container, 25.5 spacings below.
     let floor = -20.5 * dx;
     let on_face = SURFACE_FRACTION * full([0.0, floor]);
-    let s = sample(
-        &l.particles,
-        &l.particles.pos,
-        &l.kernel,
-        &[None, None],
-        [0.0, floor],
-        on_face,
-    );
+    let s = sample_at(&l, [0.0, floor], on_face);
     assert!((s.pressure - 1234.5).abs() < 1e-9, "on the floor's face");
 }
