@@ -235,7 +235,8 @@ pub fn syntax_message(text: &str, e: &toml::de::Error) -> String {
                 .count()
                 + 1;
             // A missing key is reported at the header of the section that lacks it.
-            let header = text[span.start..].lines().next().unwrap_or("").trim();
+            let header = text.get(span.start..).and_then(|t| t.lines().next());
+            let header = header.unwrap_or("").trim();
             let section = if header.starts_with('[') && what.starts_with("missing field") {
                 format!(" in the section `{header}` that starts there")
             } else {

@@ -94,14 +94,15 @@ pub fn measure(scene: &Scene, run_dir: &Path) -> Result<Measured, ValidationErro
             message: "its particles.h5 needs a frame after the first".into(),
         });
     }
-    let mut energy_excess_max = f64::NEG_INFINITY;
-    let mut velocity_l2 = f64::NAN;
-    for index in 1..count {
-        let frame = frames.read(index)?;
-        let (error, energy, exact_energy) = against_exact(&frame, field, rate, scene);
-        energy_excess_max = energy_excess_max.max(energy / exact_energy - 1.0);
-        velocity_l2 = (error / exact_energy).sqrt();
-    }
+    let sums = (1..count)
+        .map(|index| Ok(against_exact(&frames.read(index)?, field, rate, scene)))
+        .collect::<Result<Vec<_>, ValidationError>>()?;
+    let energy_excess_max = sums
+        .iter()
+        .map(|(_, energy, exact_energy)| energy / exact_energy - 1.0)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let (error, _, exact_energy) = sums[sums.len() - 1];
+    let velocity_l2 = (error / exact_energy).sqrt();
     Ok(Measured::new(
         (fitted - rate).abs() / rate,
         &DETAILS,
