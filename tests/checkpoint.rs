@@ -341,6 +341,59 @@ fn a_continued_periodic_run_is_bit_identical_to_one_never_stopped() {
     assert_split_run_is_identical::<2>(dir.path(), &scene, 0.15, 0.4);
 }
 
+#[test]
+fn a_forced_resume_with_another_output_interval_writes_frames_on_the_new_one() {
+    // Stopped at 0.02 s with frames every 0.005 s (frame 4 written, 5 due next), resumed with
+    // frames every 0.002 s and every 0.0075 s: the checkpoint's frame count of the old interval
+    // put the next frame at 5 × 0.002 = 0.01 s, behind the run, and the first step ran
+    // backwards; or at 5 × 0.0075 = 0.0375 s, leaving out the frame at 0.0225 s.
+    let dir = TempDir::new("ckpt-interval");
+    let base = base_run(dir.path());
+    let scene = std::fs::read_to_string(dir.path().join("dam_break_2d.toml")).unwrap();
+    for (interval, expected) in [
+        (0.002, vec![0.022, 0.024, 0.026, 0.028, 0.03]),
+        (0.0075, vec![0.0225, 0.03]),
+    ] {
+        let run = dir.path().join(format!("every_{interval}"));
+        copy_dir(&base, &run);
+        let file = dir.path().join(format!("every_{interval}.toml"));
+        let edited = scene.replace(
+            "output_interval = 0.005",
+            &format!("output_interval = {interval}"),
+        );
+        std::fs::write(&file, edited).unwrap();
+        let options = ResumeOptions {
+            force: true,
+            scene: Some(file),
+            ..resume_options(0.03)
+        };
+        let located = resume::locate(&run).unwrap();
+        let summary = run::resume(&located.checkpoint, &options).unwrap_or_else(|e| panic!("{e}"));
+        let after: Vec<f64> = summary
+            .frames
+            .iter()
+            .map(|f| f.time)
+            .filter(|&t| t > 0.02 + 1e-9)
+            .collect();
+        assert_eq!(
+            after.len(),
+            expected.len(),
+            "every {interval} s: frames at {after:?}"
+        );
+        for (t, e) in after.iter().zip(&expected) {
+            assert!(
+                (t - e).abs() < 1e-9,
+                "every {interval} s: frames at {after:?}"
+            );
+        }
+        let steps = crate::common::stats_column(&run, "dt");
+        assert!(
+            steps.iter().all(|&dt| dt > 0.0),
+            "every {interval} s: {steps:?}"
+        );
+    }
+}
+
 fn isph(args: &[&str]) -> Output {
     isph_command().args(args).output().unwrap()
 }

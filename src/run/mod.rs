@@ -238,6 +238,25 @@ fn on_frame(time: f64, interval: f64) -> f64 {
     }
 }
 
+/// The index of the next scheduled frame of a run resumed at `time` whose checkpoint scheduled
+/// frame `stored` next: that one where it is the next multiple of `interval` after `time`, as
+/// it always is when the output interval is the checkpoint's. A forced resume with another
+/// interval (`isph resume --force`) counts the frames of the old one in `stored`, which would
+/// put the next frame long past or, worse, before `time`, and the step towards it backwards: it
+/// takes the first multiple of the new interval after `time`.
+fn resumed_next_output(stored: u64, time: f64, interval: f64) -> u64 {
+    let rounding = FRAME_TIME_ROUNDING * interval;
+    let scheduled = |k: u64| k as f64 * interval;
+    let is_next = stored >= 1
+        && scheduled(stored - 1) <= time + rounding
+        && scheduled(stored) > time - rounding;
+    if is_next {
+        stored
+    } else {
+        ((time + rounding) / interval).floor() as u64 + 1
+    }
+}
+
 impl<'a, const D: usize> Driver<'a, D> {
     /// A driver for `sim`, fresh or continuing from `resumed`.
     fn new(
@@ -256,7 +275,9 @@ impl<'a, const D: usize> Driver<'a, D> {
             requested_end: until.unwrap_or(scene.end_time),
             end: on_frame(until.unwrap_or(scene.end_time), scene.output_interval),
             output,
-            next_output: state.map_or(0, |s| s.next_output),
+            next_output: state.map_or(0, |s| {
+                resumed_next_output(s.next_output, s.time, scene.output_interval)
+            }),
             wall_before: state.map_or(0.0, |s| s.wall_seconds),
             started: now,
             last_saved: resumed.map(|c| Saved {
