@@ -941,6 +941,90 @@ friction = 0.5
 }
 
 #[test]
+fn fluid_put_back_off_bodies_keeps_its_particles_apart_and_outside() {
+    // Two discs side by side just off the floor, 1 mm apart (a tenth of a spacing): the
+    // crevices between them and between each and the floor are narrower than the contact's
+    // gap (a quarter spacing) from both of their surfaces. Fluid particles anywhere around the
+    // crevices, put back off the bodies (`Bodies::keep_out`), land outside both discs and no
+    // two on one point; particles along one normal keep their distances. Put on the gap
+    // surface instead, every particle on a normal lands on one point, and every particle in a
+    // crevice converges to the point at the gap from both surfaces: particles the flow drives
+    // there pile onto one another for good (coincident particles take the same steps), which
+    // blew up a pile of discs in a surge.
+    let (radius, spacing) = (0.05, 0.01);
+    let gap = 0.25 * spacing;
+    let discs = format!(
+        "[[body]]\nshape = \"circle\"\ncenter = [0.45, {y}]\nradius = {radius}\ndensity = 1500.0\n\n\
+         [[body]]\nshape = \"circle\"\ncenter = [0.551, {y}]\nradius = {radius}\ndensity = 1500.0\n",
+        y = radius + 0.1 * spacing,
+    );
+    let scene = scene_from_text(&tank(2, spacing, [1.0, 0.4, 0.0], 0.2, 0.1, &discs));
+    let bodies = isph::Simulation::<2>::new(&scene).unwrap().bodies;
+    let outside = |x: &[f64; 3]| {
+        bodies
+            .bodies
+            .iter()
+            .map(|b| b.surface_distance(2)(x))
+            .fold(f64::MAX, f64::min)
+    };
+    let put_back = |x: [f64; 3]| {
+        let (mut x, mut u) = (x, [0.0, -0.5, 0.0]);
+        let (moved, _) = bodies.keep_out(&mut x, &mut u, gap, 2);
+        moved.then_some(x)
+    };
+    // Points 0.37 mm apart over the crevices (an irregular step, no lattice line on a
+    // surface), those the contact moves.
+    let step = 0.037 * spacing;
+    let moved: Vec<[f64; 3]> = (0..160)
+        .flat_map(|i| (0..330).map(move |j| [0.47 + i as f64 * step, j as f64 * step, 0.0]))
+        .filter(|x| outside(x) > -0.5 * spacing && x[1] > 0.0)
+        .filter_map(put_back)
+        .collect();
+    assert!(moved.len() > 1000, "only {} points in reach", moved.len());
+    for x in &moved {
+        assert!(
+            outside(x) >= 0.0,
+            "put back at {x:?}, {} m inside a disc",
+            -outside(x)
+        );
+    }
+    let mut sorted = moved.clone();
+    sorted.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let closest = sorted
+        .iter()
+        .enumerate()
+        .flat_map(|(k, a)| {
+            sorted[k + 1..]
+                .iter()
+                .take_while(move |b| b[0] - a[0] < 1e-3 * spacing)
+                .map(move |b| distance(*a, *b))
+        })
+        .fold(f64::MAX, f64::min);
+    assert!(
+        closest > 1e-6 * spacing,
+        "two of {} particles put back {closest} m apart",
+        moved.len()
+    );
+    // Along the normal of the first disc at 30° from its lowest point, at depths 0.1 … 0.9 of
+    // the gap: as far apart after as before.
+    let (c, angle) = ([0.45, radius + 0.1 * spacing], -60f64.to_radians());
+    let on_normal = |depth: f64| {
+        let r = radius + gap - depth;
+        [c[0] + r * angle.cos(), c[1] + r * angle.sin(), 0.0]
+    };
+    let landed: Vec<[f64; 3]> = (1..10)
+        .map(|k| put_back(on_normal(0.1 * k as f64 * gap)).expect("in reach"))
+        .collect();
+    for pair in landed.windows(2) {
+        let apart = distance(pair[0], pair[1]);
+        assert!(
+            (apart - 0.1 * gap).abs() < 1e-3 * gap,
+            "particles 0.1 gap apart on a normal land {apart} m apart: {landed:?}"
+        );
+    }
+}
+
+#[test]
 fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_nothing_passes_through_them() {
     // scenes/dam_break_solids_2d.toml at twice its spacing (D/dx = 5), to 3 s: four discs at
     // s = 1.5 and four at s = 0.8 in the surge. Once the surge has passed (2–3 s), in still

@@ -240,7 +240,7 @@ impl Bodies {
 
     /// The container's faces a body can touch: the axis d, the plane's coordinate along it
     /// and the sign of its inward normal (+1 at the low face, −1 at the high one).
-    fn planes(&self) -> impl Iterator<Item = (usize, f64, f64)> + '_ {
+    pub(super) fn planes(&self) -> impl Iterator<Item = (usize, f64, f64)> + '_ {
         self.faces.iter().enumerate().flat_map(|(d, face)| {
             face.iter()
                 .flat_map(move |&(lo, hi)| [(d, lo, 1.0), (d, hi, -1.0)])

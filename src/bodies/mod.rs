@@ -19,6 +19,7 @@
 //! never advected, so a body never changes shape.
 
 mod contact;
+mod keep_out;
 
 use crate::math::aabb::Aabb;
 use crate::math::rotation::{self, cross, to_3d, Mat3, Quaternion, Vec3};
@@ -26,9 +27,6 @@ use crate::math::shape::Shape;
 use crate::math::vector::dot;
 use crate::particles::{Kind, Particles};
 use crate::scene::{BodyMotion, Scene};
-
-/// Rounds of `Bodies::keep_out` over the bodies for one fluid particle.
-const KEEP_OUT_ROUNDS: usize = 8;
 
 /// The lasting state of a rigid body.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -621,59 +619,6 @@ impl Bodies {
             ..s
         };
         body.drift(s.velocity, dt);
-    }
-}
-
-impl Bodies {
-    /// The hard contact of a fluid particle at x with velocity u with the bodies, as
-    /// `Faces::contact` with the walls: a particle closer than `gap` to a body's surface (or
-    /// inside it) is put back `gap` off it along the surface's normal, and keeps no velocity
-    /// into the body relative to the body's surface. Returns whether it moved, and whether it
-    /// had crossed the surface (a penetration).
-    pub fn keep_out(&self, x: &mut Vec3, u: &mut Vec3, gap: f64, dims: usize) -> (bool, bool) {
-        let (mut moved, mut crossed) = (false, false);
-        // More rounds for a particle put back off one body into another beside it (two bodies
-        // in contact): put back off each in turn, it moves out of the crevice between them; one
-        // still squeezed after the last round stays where that put it.
-        for _ in 0..KEEP_OUT_ROUNDS {
-            let mut again = false;
-            for body in &self.bodies {
-                let s = &body.state;
-                let arm: Vec3 = std::array::from_fn(|d| x[d] - s.centre[d]);
-                if arm.iter().map(|a| a * a).sum::<f64>() > (body.reach + gap).powi(2) {
-                    continue;
-                }
-                let surface = body.surface_distance(dims);
-                let distance = surface(x);
-                if distance >= gap {
-                    continue;
-                }
-                let Some(normal) = outward_normal(&surface, *x, gap, dims) else {
-                    continue;
-                };
-                for d in 0..dims {
-                    x[d] += (gap - distance) * normal[d];
-                }
-                let wall = rigid_velocity(
-                    s.velocity,
-                    body.angular_velocity(),
-                    std::array::from_fn(|d| x[d] - s.centre[d]),
-                );
-                let into: f64 = (0..dims).map(|d| (u[d] - wall[d]) * normal[d]).sum();
-                if into < 0.0 {
-                    for d in 0..dims {
-                        u[d] -= into * normal[d];
-                    }
-                }
-                moved = true;
-                again = true;
-                crossed = crossed || distance < 0.0;
-            }
-            if !again {
-                break;
-            }
-        }
-        (moved, crossed)
     }
 }
 
