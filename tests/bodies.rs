@@ -88,6 +88,33 @@ velocity = [0.3, 0.0]
 }
 
 #[test]
+fn a_body_under_a_constant_torque_turns_by_half_its_angular_acceleration_times_t_squared() {
+    // A disc given the same angular impulse τ Δt at every step from rest (`Bodies::advance`, the
+    // momentum balance of Eq. 15): ω = α t with α = τ/I, and the angle after the steps α t²/2
+    // to round-off, as the centre under a constant force (the trapezoid). A turn of ωⁿ⁺¹ Δt
+    // per step led that by α Δt t/2, half a step's turn, at every frame.
+    let body =
+        "[[body]]\nshape = \"circle\"\ncenter = [0.5, 0.7]\nradius = 0.05\ndensity = 800.0\n";
+    let scene = scene_from_text(&tank(2, 0.01, [1.0, 1.0, 0.0], 0.1, 0.02, body));
+    let mut bodies = isph::Simulation::<2>::new(&scene).unwrap().bodies;
+    let (alpha, dt, steps) = (2.0, 1e-3, 100);
+    let torque = alpha * bodies.bodies[0].inertia[2][2];
+    let z = |v: f64| [0.0, 0.0, v];
+    for k in 0..steps {
+        let (impulses, forces) = ([[0.0; 3], z(torque * dt)], [[0.0; 3], z(torque)]);
+        bodies.advance(0, impulses, forces, [[0.0; 3]; 2], false, k as f64 * dt, dt);
+    }
+    let t = steps as f64 * dt;
+    let [qw, _, _, qz] = bodies.bodies[0].state.orientation.0;
+    let angle = 2.0 * qz.atan2(qw);
+    assert!(
+        (angle - 0.5 * alpha * t * t).abs() < 1e-12,
+        "turned by {angle} rad in {t} s, against α t²/2 = {}",
+        0.5 * alpha * t * t
+    );
+}
+
+#[test]
 fn a_spinning_body_in_the_air_keeps_its_angular_momentum_and_shape() {
     let dir = TempDir::new("bodies-spin");
     // A 3D box spun about an axis that is no principal axis: ω changes, L does not.

@@ -181,7 +181,7 @@ impl Bodies {
                 body.state.angular_momentum = [0.0; 3];
             } else if body.state.resting {
                 // Let go: it moves over this step from rest.
-                body.drift([0.0; 3], dt);
+                body.drift([0.0; 3], [0.0; 3], dt);
             }
             body.state.resting = held;
         }

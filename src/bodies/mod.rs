@@ -255,15 +255,19 @@ impl RigidBody {
     }
 
     /// Moves the pose over a step of `dt` over which the centre's velocity went from `start` to
-    /// the state's: the centre by the trapezoid, exact under a constant force (free fall), and
-    /// the orientation by a turn of ωⁿ⁺¹ Δt (Eq. 15–16).
-    fn drift(&mut self, start: Vec3, dt: f64) {
+    /// the state's and the angular velocity from `start_spin` to the state's: both by the
+    /// trapezoid, the centre by (Vⁿ + Vⁿ⁺¹) Δt/2, exact under a constant force (free fall), and
+    /// the orientation by a turn of (ωⁿ + ωⁿ⁺¹) Δt/2, exact under a constant torque (Eq. 15–16).
+    /// So a frame holds a body's pose and velocities at one time, as it holds the fluid's
+    /// (`Simulation::present_positions`).
+    fn drift(&mut self, start: Vec3, start_spin: Vec3, dt: f64) {
         let s = &mut self.state;
         for d in 0..3 {
             s.centre[d] += 0.5 * dt * (start[d] + s.velocity[d]);
         }
         let w = self.angular_velocity();
-        self.state.orientation = Quaternion::from_rotation_vector(w.map(|w| w * dt))
+        let turn: Vec3 = std::array::from_fn(|d| 0.5 * dt * (start_spin[d] + w[d]));
+        self.state.orientation = Quaternion::from_rotation_vector(turn)
             .then_after(self.state.orientation)
             .normalised();
     }
@@ -575,7 +579,7 @@ impl Bodies {
         dt: f64,
     ) {
         let body = &mut self.bodies[b];
-        let s = body.state;
+        let (s, spin) = (body.state, body.angular_velocity());
         if let Some(target) = body.target(time, dt) {
             body.state = RigidState {
                 centre: target.centre,
@@ -618,7 +622,7 @@ impl Bodies {
             wet,
             ..s
         };
-        body.drift(s.velocity, dt);
+        body.drift(s.velocity, spin, dt);
     }
 }
 
