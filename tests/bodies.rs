@@ -1065,7 +1065,7 @@ fn in_a_dam_break_heavy_solids_stay_down_light_ones_float_and_nothing_passes_thr
     // the light ones afloat or held down by a disc resting on them; a light disc lying on the
     // floor with nothing on it is the known limitation of a pocket under a pile (docs/bodies.md,
     // "Known limitation: light bodies under a pile stay on the floor"). Measured: heavy on the
-    // floor 3, 4, 2 of 4 and the others on a disc; light afloat 2, 3, 2 and held down 2, 0, 2
+    // floor 2, 2, 2 of 4 and the others on a disc; light afloat 2, 3, 2 and held down 2, 1, 2
     // (with the fluid put on the contact's gap surface instead of mirrored across it, and the
     // bodies turned by ωⁿ⁺¹ Δt: heavy on the floor 1, 4, 2, light afloat 1, 4, 1).
     let mut scene = crate::common::shipped_scene("dam_break_solids_2d.toml");
@@ -1122,7 +1122,7 @@ fn solids_centres(scene: &isph::scene::Scene) -> Vec<[f64; 2]> {
     let dir = TempDir::new("bodies-solids");
     run_scene(scene, dir.path(), 3.0);
     // Once the surge has passed (1.5 s), no particle faster than three times its speed √(2gH)
-    // (H = 0.25 m): measured 2.3–5.0 m/s over six draws; coincident fluid particles squeezed
+    // (H = 0.25 m): measured 2.3–3.8 m/s over six draws; coincident fluid particles squeezed
     // in a crevice once blew a pile up to 79 m/s.
     let (time, speed) = (
         stats_column(dir.path(), "time"),

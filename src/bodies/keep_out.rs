@@ -82,9 +82,10 @@ impl Bodies {
     }
 
     /// A particle the rounds left inside a body (squeezed between it and a face or another
-    /// body, off which the last round mirrored it) is put on that body's gap surface: a face
-    /// it then lies beyond is the next step's advection's to put it back off
-    /// (`Faces::contact`).
+    /// body, off which the last round mirrored it) is mirrored across that body's surface:
+    /// outside it, if within the gap, which the next step's contact takes up again. Put on
+    /// the gap surface instead, the particles squeezed into one crevice would land on one
+    /// point.
     fn put_out_of_bodies(&self, x: &mut Vec3, gap: f64, dims: usize) {
         for body in &self.bodies {
             let surface = body.surface_distance(dims);
@@ -94,7 +95,7 @@ impl Bodies {
             }
             if let Some(normal) = outward_normal(&surface, *x, gap, dims) {
                 for d in 0..dims {
-                    x[d] += (gap - distance) * normal[d];
+                    x[d] -= 2.0 * distance * normal[d];
                 }
             }
         }
