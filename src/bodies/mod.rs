@@ -579,7 +579,7 @@ impl Bodies {
         dt: f64,
     ) {
         let body = &mut self.bodies[b];
-        let (s, spin) = (body.state, body.angular_velocity());
+        let s = body.state;
         if let Some(target) = body.target(time, dt) {
             body.state = RigidState {
                 centre: target.centre,
@@ -612,6 +612,7 @@ impl Bodies {
             }
         };
         let (extra, extra_angular) = (half_change(force, s.force), half_change(torque, s.torque));
+        let spin = body.angular_velocity();
         body.state = RigidState {
             velocity: std::array::from_fn(|d| s.velocity[d] + (impulse[d] + extra[d]) / body.mass),
             angular_momentum: std::array::from_fn(|d| {
